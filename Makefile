@@ -1,0 +1,73 @@
+# Thin wrapper over meson: `make demo` and `make test` work on a fresh Debian 12 machine
+# (they apt-get what is missing first). Everything real lives in meson.build and tests/.
+SHELL := /bin/bash
+PYTHON := /usr/bin/python3
+BUILD := build
+SAN_BUILD := build-sanitize
+SAMPLE := examples/data/bunny.ply
+DEMO_OUT := $(BUILD)/demo/bunny_mesh.ply
+
+# Debian packages each target needs; `deps-*` installs only the missing ones.
+CORE_PKGS := g++ pkg-config meson ninja-build libeigen3-dev libnanoflann-dev libcmocka-dev
+TEST_PKGS := $(CORE_PKGS) python3-cffi python3-numpy python3-pytest python3-matplotlib \
+             valgrind clang libclang-rt-14-dev nodejs npm
+BENCH_PKGS := $(TEST_PKGS) python3-open3d libcgal-dev libgmp-dev libmpfr-dev
+
+define apt_install
+	@missing=""; for p in $(1); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
+	if [ -n "$$missing" ]; then \
+	  echo "Installing missing Debian packages:$$missing"; \
+	  SUDO=""; [ "$$(id -u)" -ne 0 ] && SUDO=sudo; \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq $$missing; \
+	fi
+endef
+
+.PHONY: all deps deps-test deps-bench build demo test test-c test-python test-node test-rust \
+        test-sanitize bench bench-quick fuzz clean
+
+all: build
+
+deps:
+	$(call apt_install,$(CORE_PKGS))
+
+deps-test:
+	$(call apt_install,$(TEST_PKGS))
+
+deps-bench:
+	$(call apt_install,$(BENCH_PKGS))
+
+$(BUILD)/build.ninja:
+	meson setup $(BUILD) --buildtype=release
+
+build: deps $(BUILD)/build.ninja
+	ninja -C $(BUILD)
+
+demo: build
+	@mkdir -p $(BUILD)/demo
+	$(BUILD)/examples/gmpu-reconstruct $(SAMPLE) -o $(DEMO_OUT) --normals-out $(BUILD)/demo/bunny_oriented_points.ply
+	@echo
+	@echo "Mesh written to $(abspath $(DEMO_OUT))"
+	@echo "Oriented points written to $(abspath $(BUILD)/demo/bunny_oriented_points.ply)"
+
+test: deps-test build
+	$(MAKE) --no-print-directory test-c test-python test-node test-rust test-sanitize
+
+test-c: build
+	meson test -C $(BUILD) --print-errorlogs
+
+test-python: build
+
+test-node: build
+
+test-rust: build
+
+test-sanitize: deps-test
+
+bench: deps-bench build
+
+bench-quick: deps-bench build
+
+fuzz: deps-test
+
+clean:
+	rm -rf $(BUILD) $(SAN_BUILD) build-fuzz

@@ -1,0 +1,316 @@
+/*
+ * gmpu.h — the whole C ABI of gmpu: unoriented points → oriented MPU implicit → mesh.
+ *
+ * The pipeline has one verb per stage, each reading the previous stage's result:
+ *
+ *     gmpu_surface_create → set_points (→ set_normals) → fit → orient → evaluate / polygonize
+ *
+ * Conventions that hold for every function below:
+ *   - Every fallible function returns a gmpu_status; GMPU_OK is 0. On failure nothing is
+ *     half-done: outputs are left untouched (or NULL), no file is left half-written, and
+ *     the handle stays usable and destroyable.
+ *   - The message of a failure is available from gmpu_last_error() (the calling thread's
+ *     last failure, any function) and, for calls that modify a surface, also from
+ *     gmpu_surface_last_error(surface).
+ *   - Ownership: what gmpu_*_create / gmpu_*_read / gmpu_surface_polygonize hands out,
+ *     the matching gmpu_*_destroy frees. Pointers returned by accessors are owned by the
+ *     object they came from and stay valid until it is destroyed. Input arrays are
+ *     copied; gmpu never keeps a caller's pointer.
+ *   - No function throws, aborts or longjmps. All coordinates are in the caller's units.
+ *   - f is positive inside the reconstructed solid and negative outside; normals point
+ *     out of the solid.
+ *   - Thread safety: different handles never share mutable state and may be used from
+ *     different threads at once. On one surface handle, functions taking a const pointer
+ *     (evaluate, copy_normals, get_param, get_stat, point_count) may run concurrently with
+ *     each other; every other call on that handle needs exclusive access.
+ *
+ * Parameters and statistics go through gmpu_surface_set_param / gmpu_surface_get_stat with
+ * an enum key (as zstd does), so new knobs never change a struct layout. Enum values are
+ * fixed forever; new ones are only ever appended.
+ */
+#ifndef GMPU_GMPU_H
+#define GMPU_GMPU_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#if defined(_WIN32) && defined(GMPU_BUILDING_LIBRARY)
+#define GMPU_API __declspec(dllexport)
+#elif defined(_WIN32)
+#define GMPU_API
+#else
+#define GMPU_API __attribute__((visibility("default")))
+#endif
+
+/* Version of this header. Compare with gmpu_version_number() to detect a mismatched
+ * library at run time. GMPU_ABI_VERSION changes only when the ABI breaks (it is the
+ * SONAME's number: libgmpu.so.1). */
+#define GMPU_VERSION_MAJOR 0
+#define GMPU_VERSION_MINOR 1
+#define GMPU_VERSION_PATCH 0
+#define GMPU_VERSION_NUMBER 100 /* MAJOR*10000 + MINOR*100 + PATCH */
+#define GMPU_ABI_VERSION 1
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/* ---- opaque handles ------------------------------------------------------------------ */
+
+/* A reconstruction: the input points, the octree of local fits, their orientation. */
+typedef struct gmpu_surface gmpu_surface;
+/* A triangle mesh (output of polygonize, or built from caller arrays for writing). */
+typedef struct gmpu_mesh gmpu_mesh;
+/* A point cloud read from a file: positions and optional normals. */
+typedef struct gmpu_points gmpu_points;
+
+/* ---- status codes -------------------------------------------------------------------- */
+
+typedef enum gmpu_status {
+    GMPU_OK = 0,
+    GMPU_ERROR_INVALID_ARGUMENT = 1, /* NULL pointer, bad count/stride, parameter out of range */
+    GMPU_ERROR_INVALID_INPUT = 2,    /* NaN/inf coordinates, too few points, size mismatch */
+    GMPU_ERROR_DEGENERATE_INPUT = 3, /* identical, collinear or coplanar points: no solid */
+    GMPU_ERROR_WRONG_ORDER = 4,      /* a stage called before the one it needs */
+    GMPU_ERROR_OUT_OF_MEMORY = 5,
+    GMPU_ERROR_LIMIT_EXCEEDED = 6,   /* GMPU_PARAM_MAX_CELLS or the triangle cap was hit */
+    GMPU_ERROR_CANCELLED = 7,        /* the progress callback returned non-zero */
+    GMPU_ERROR_IO = 8,               /* a file could not be opened, read or written */
+    GMPU_ERROR_PARSE = 9,            /* a file's contents are malformed or truncated */
+    GMPU_ERROR_UNSUPPORTED = 10,     /* unknown file extension or format variant */
+    GMPU_ERROR_INTERNAL = 11         /* a bug: please report it with the message */
+} gmpu_status;
+
+/* The enumerator's name ("GMPU_ERROR_CANCELLED"), or "GMPU_UNKNOWN_STATUS". Never NULL;
+ * static storage. */
+GMPU_API const char *gmpu_status_name(gmpu_status status);
+
+/* Message of the most recent failed gmpu call made by the calling thread ("" if none).
+ * Valid until the next gmpu call on this thread. Thread-safe. */
+GMPU_API const char *gmpu_last_error(void);
+
+/* ---- version ------------------------------------------------------------------------- */
+
+GMPU_API uint32_t gmpu_version_number(void);     /* GMPU_VERSION_NUMBER of the library */
+GMPU_API const char *gmpu_version_string(void);  /* "0.1.0"; static storage */
+GMPU_API uint32_t gmpu_abi_version(void);        /* GMPU_ABI_VERSION of the library */
+
+/* ---- parameters, stages, statistics -------------------------------------------------- */
+
+typedef enum gmpu_param {
+    /* ε: largest Taubin distance allowed between a cell's points and its local fit, as a
+     * fraction of the bounding-box diagonal. Smaller keeps more detail and costs time.
+     * Default 0.002, range (0, 1). Changing it discards a previous fit. */
+    GMPU_PARAM_ERROR = 1,
+    /* Deepest octree level (root = 0). Default 10, range 1..16. Discards a previous fit. */
+    GMPU_PARAM_MAX_DEPTH = 2,
+    /* Fewest points a local fit uses; the support radius grows until it holds them.
+     * Default 15, range 6..1000. Discards a previous fit. */
+    GMPU_PARAM_MIN_POINTS = 3,
+    /* α: support radius = α × cell diagonal. Default 0.75, range [0.5, 2]. Discards a
+     * previous fit. */
+    GMPU_PARAM_SUPPORT_SCALE = 4,
+    /* 1 (default): fit piecewise quadrics at sharp edges and corners; 0: smooth models
+     * only. Discards a previous fit. */
+    GMPU_PARAM_SHARP_FEATURES = 5,
+    /* Polygonize: grid cubes along the longest side of the points' bounding box.
+     * 0 (default) picks one from the octree (fine enough for the detail the fit has).
+     * Range 0 or 8..4096. */
+    GMPU_PARAM_RESOLUTION = 6,
+    /* Level of detail: evaluate and polygonize using octree cells down to this level
+     * only (paper Fig. 7). 0 (default) uses every level. Range 0..16. */
+    GMPU_PARAM_LEVEL = 7,
+    /* Worker threads for fit, orient and polygonize. 0 (default) uses every core. */
+    GMPU_PARAM_THREADS = 8,
+    /* Resource cap: fit fails with GMPU_ERROR_LIMIT_EXCEEDED instead of creating more
+     * octree cells than this. Default 20,000,000 (about 4 GB). Range 1..1e9. */
+    GMPU_PARAM_MAX_CELLS = 9,
+    /* Resource cap: polygonize fails with GMPU_ERROR_LIMIT_EXCEEDED instead of making
+     * more triangles than this. Default 100,000,000. Range 1..2e9. */
+    GMPU_PARAM_MAX_TRIANGLES = 10
+} gmpu_param;
+
+typedef enum gmpu_stage {
+    GMPU_STAGE_FIT = 1,
+    GMPU_STAGE_ORIENT = 2,
+    GMPU_STAGE_POLYGONIZE = 3
+} gmpu_stage;
+
+typedef enum gmpu_stat {
+    GMPU_STAT_POINTS = 1,             /* input points */
+    GMPU_STAT_CELLS = 2,              /* octree cells, all levels */
+    GMPU_STAT_LEAVES = 3,             /* leaf cells (the local functions that are blended) */
+    GMPU_STAT_DEPTH = 4,              /* deepest leaf level */
+    GMPU_STAT_QUADRIC_CELLS = 5,      /* leaves fitted with a general quadric */
+    GMPU_STAT_BIVARIATE_CELLS = 6,    /* leaves fitted with a bivariate quadratic */
+    GMPU_STAT_PIECEWISE_CELLS = 7,    /* leaves fitted with piecewise quadrics (edge/corner) */
+    GMPU_STAT_COMPONENTS = 8,         /* connected pieces found by orient */
+    GMPU_STAT_FLIPPED_CELLS = 9,      /* leaves whose fitted sign orient reversed */
+    GMPU_STAT_FIT_SECONDS = 10,       /* wall time of the last fit */
+    GMPU_STAT_ORIENT_SECONDS = 11,
+    GMPU_STAT_POLYGONIZE_SECONDS = 12,
+    GMPU_STAT_RESOLUTION = 13,        /* grid resolution the last polygonize used */
+    GMPU_STAT_BBOX_DIAGONAL = 14      /* diagonal of the points' bounding box */
+} gmpu_stat;
+
+/* Progress and cancellation. Called on the thread that called fit / orient / polygonize,
+ * at least every 50 ms of work, with fraction in [0, 1] (non-decreasing within a stage;
+ * 1 when the stage completes). Return 0 to go on; non-zero cancels: the call stops within
+ * 100 ms and returns GMPU_ERROR_CANCELLED, and the surface keeps the stages completed
+ * before the cancelled one. The callback must not call gmpu functions on the same
+ * surface. */
+typedef int (*gmpu_progress_fn)(void *user, gmpu_stage stage, double fraction);
+
+/* ---- surface: create, configure, destroy --------------------------------------------- */
+
+/* Makes an empty surface with default parameters. *out is set to NULL on failure.
+ * Errors: INVALID_ARGUMENT (out is NULL), OUT_OF_MEMORY. */
+GMPU_API gmpu_status gmpu_surface_create(gmpu_surface **out);
+
+/* Frees the surface and everything it owns. NULL is a no-op. Meshes made by polygonize
+ * are independent and stay valid. Calling it twice on the same pointer is undefined (as
+ * with free); bindings guard against that. */
+GMPU_API void gmpu_surface_destroy(gmpu_surface *surface);
+
+/* Message of the last failed call that modified this surface ("" if none). Valid until the
+ * next non-const call on the surface. Returns "" for NULL. */
+GMPU_API const char *gmpu_surface_last_error(const gmpu_surface *surface);
+
+/* Sets / reads one parameter (see gmpu_param). Errors: INVALID_ARGUMENT (NULL surface,
+ * unknown key, value out of range or not finite; the message names the range). */
+GMPU_API gmpu_status gmpu_surface_set_param(gmpu_surface *surface, gmpu_param key, double value);
+GMPU_API gmpu_status gmpu_surface_get_param(const gmpu_surface *surface, gmpu_param key,
+                                            double *value);
+
+/* Reads a statistic of the latest completed stages (0 before they ran). Errors:
+ * INVALID_ARGUMENT (NULL pointer or unknown key). */
+GMPU_API gmpu_status gmpu_surface_get_stat(const gmpu_surface *surface, gmpu_stat key,
+                                           double *value);
+
+/* Registers the progress callback (NULL to remove). user is passed back untouched. */
+GMPU_API gmpu_status gmpu_surface_set_progress(gmpu_surface *surface, gmpu_progress_fn fn,
+                                               void *user);
+
+/* ---- surface: input ------------------------------------------------------------------ */
+
+/* Copies count points, x y z each, from xyz; consecutive points are stride bytes apart
+ * (0 means tightly packed: 3 × sizeof(double) or 3 × sizeof(float)). Replaces earlier
+ * points and discards any fit, orientation and input normals.
+ * Errors: INVALID_ARGUMENT (NULL, stride smaller than one point), INVALID_INPUT (fewer
+ * points than GMPU_PARAM_MIN_POINTS; a NaN or infinite coordinate, with its index),
+ * DEGENERATE_INPUT (all points identical, collinear or coplanar: they bound no volume),
+ * OUT_OF_MEMORY. On failure the previous points are kept. Cost: O(n log n). */
+GMPU_API gmpu_status gmpu_surface_set_points_f64(gmpu_surface *surface, const double *xyz,
+                                                 size_t count, size_t stride);
+GMPU_API gmpu_status gmpu_surface_set_points_f32(gmpu_surface *surface, const float *xyz,
+                                                 size_t count, size_t stride);
+
+/* Optional: outward normals for the points, same count and order. When given, orient
+ * signs each local fit by agreement with them and belief propagation is skipped; they
+ * need not be unit length, but must be finite and non-zero. Discards any orientation.
+ * Errors: INVALID_ARGUMENT, WRONG_ORDER (no points yet), INVALID_INPUT (count differs from
+ * the point count; NaN, inf or zero normal, with its index). */
+GMPU_API gmpu_status gmpu_surface_set_normals_f64(gmpu_surface *surface, const double *nxyz,
+                                                  size_t count, size_t stride);
+GMPU_API gmpu_status gmpu_surface_set_normals_f32(gmpu_surface *surface, const float *nxyz,
+                                                  size_t count, size_t stride);
+
+/* Number of points set (0 before set_points or for NULL). */
+GMPU_API size_t gmpu_surface_point_count(const gmpu_surface *surface);
+
+/* ---- surface: the stages ------------------------------------------------------------- */
+
+/* Builds the adaptive octree and a local shape function per cell (paper §3): surface
+ * variation σ > 0.25 → general quadric (Taubin fit), else bivariate quadratic in the PCA
+ * frame, piecewise quadrics at sharp features; cells are subdivided until the Taubin
+ * error is below GMPU_PARAM_ERROR. Discards a previous orientation.
+ * Errors: WRONG_ORDER (no points), LIMIT_EXCEEDED (GMPU_PARAM_MAX_CELLS), CANCELLED,
+ * OUT_OF_MEMORY. Cost: about O(n log n); 35k points take ~0.1 s on 2 cores. */
+GMPU_API gmpu_status gmpu_surface_fit(gmpu_surface *surface);
+
+/* Gives every local function one consistent sign (paper §4): max-product belief
+ * propagation on the face-adjacency graph of leaf cells, advanced as a front over each
+ * connected piece; then each piece is turned so that f is positive inside the solid
+ * (nested shells alternate: a shell inside a shell bounds a cavity). With input normals,
+ * their agreement signs the fits instead. Also computes the per-point oriented normals.
+ * Errors: WRONG_ORDER (not fitted), CANCELLED, OUT_OF_MEMORY. */
+GMPU_API gmpu_status gmpu_surface_orient(gmpu_surface *surface);
+
+/* Evaluates the blended implicit f (partition of unity, quadratic B-spline weights) at
+ * count points xyz (3 doubles each, packed). values (count doubles) and gradients
+ * (3 × count doubles, ∇f) may each be NULL, but not both. f is in the caller's length
+ * units (about the signed distance near the surface, positive inside). Far from the data,
+ * beyond every leaf's support, f falls back to the coarser fits that cover the point.
+ * Honours GMPU_PARAM_LEVEL. Safe to call from several threads at once after orient.
+ * Errors: INVALID_ARGUMENT (NULL), WRONG_ORDER (not oriented), INVALID_INPUT (a NaN or
+ * infinite query, with its index; outputs untouched). Cost: O(count × log cells). */
+GMPU_API gmpu_status gmpu_surface_evaluate(const gmpu_surface *surface, const double *xyz,
+                                           size_t count, double *values, double *gradients);
+
+/* Copies the oriented unit normal of every input point (−∇f normalised; the oriented
+ * local fit where ∇f vanishes) into out: 3 × count doubles, count = point count.
+ * Errors: INVALID_ARGUMENT (NULL, count differs from the point count), WRONG_ORDER. */
+GMPU_API gmpu_status gmpu_surface_copy_normals(const gmpu_surface *surface, double *out,
+                                               size_t count);
+
+/* Extracts the zero set of f as a closed, edge-manifold, consistently wound triangle mesh
+ * (counter-clockwise seen from outside), restricted to a band around the data so that
+ * spurious zero sets of far-away quadrics never become surface. Uses
+ * GMPU_PARAM_RESOLUTION and GMPU_PARAM_LEVEL. The mesh is the caller's: free it with
+ * gmpu_mesh_destroy. Errors: INVALID_ARGUMENT, WRONG_ORDER (not oriented),
+ * LIMIT_EXCEEDED (GMPU_PARAM_MAX_TRIANGLES), CANCELLED, OUT_OF_MEMORY. */
+GMPU_API gmpu_status gmpu_surface_polygonize(gmpu_surface *surface, gmpu_mesh **out);
+
+/* ---- meshes -------------------------------------------------------------------------- */
+
+/* Builds a mesh from caller arrays (copied): vertex_count × 3 doubles, triangle_count × 3
+ * vertex indices. Errors: INVALID_ARGUMENT (NULL with a non-zero count), INVALID_INPUT
+ * (index out of range, non-finite coordinate). */
+GMPU_API gmpu_status gmpu_mesh_create(const double *vertices, size_t vertex_count,
+                                      const uint32_t *triangles, size_t triangle_count,
+                                      gmpu_mesh **out);
+GMPU_API void gmpu_mesh_destroy(gmpu_mesh *mesh); /* NULL is a no-op */
+
+GMPU_API size_t gmpu_mesh_vertex_count(const gmpu_mesh *mesh);   /* 0 for NULL */
+GMPU_API size_t gmpu_mesh_triangle_count(const gmpu_mesh *mesh); /* 0 for NULL */
+/* xyz per vertex (3 × vertex_count doubles). */
+GMPU_API const double *gmpu_mesh_vertices(const gmpu_mesh *mesh);
+/* Unit outward normal per vertex (3 × vertex_count doubles); NULL for a mesh made by
+ * gmpu_mesh_create. */
+GMPU_API const double *gmpu_mesh_normals(const gmpu_mesh *mesh);
+/* Three vertex indices per triangle (3 × triangle_count). */
+GMPU_API const uint32_t *gmpu_mesh_triangles(const gmpu_mesh *mesh);
+
+/* Writes the mesh; the format comes from the extension: .ply (binary little-endian),
+ * .obj, .off. The file is written beside the target under a temporary name and renamed,
+ * so a failure never leaves a partial file. Errors: INVALID_ARGUMENT, UNSUPPORTED
+ * (extension), IO (with the system's reason). */
+GMPU_API gmpu_status gmpu_mesh_write(const gmpu_mesh *mesh, const char *path);
+
+/* ---- point files --------------------------------------------------------------------- */
+
+/* Reads a point cloud: .ply (ascii, binary little or big endian; x y z and optional
+ * nx ny nz; other properties and elements skipped), .xyz / .txt (3 or 6 columns),
+ * .off and .obj (vertices only). Errors: INVALID_ARGUMENT, IO (missing, unreadable or a
+ * directory), PARSE (malformed, truncated or lying header; the message gives the line or
+ * element), UNSUPPORTED (extension or PLY variant), INVALID_INPUT (no points). */
+GMPU_API gmpu_status gmpu_points_read(const char *path, gmpu_points **out);
+
+/* Builds a point set from caller arrays (copied); normals may be NULL. */
+GMPU_API gmpu_status gmpu_points_create(const double *xyz, const double *normals,
+                                        size_t count, gmpu_points **out);
+GMPU_API void gmpu_points_destroy(gmpu_points *points); /* NULL is a no-op */
+
+GMPU_API size_t gmpu_points_count(const gmpu_points *points);           /* 0 for NULL */
+GMPU_API const double *gmpu_points_positions(const gmpu_points *points); /* 3 × count */
+GMPU_API const double *gmpu_points_normals(const gmpu_points *points);   /* NULL if none */
+
+/* Writes points (and normals, if any): .ply (binary little-endian) or .xyz (ascii).
+ * Atomic like gmpu_mesh_write. Errors: INVALID_ARGUMENT, UNSUPPORTED, IO. */
+GMPU_API gmpu_status gmpu_points_write(const gmpu_points *points, const char *path);
+
+#ifdef __cplusplus
+}
+#endif
+
+#endif /* GMPU_GMPU_H */

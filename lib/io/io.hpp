@@ -1,0 +1,49 @@
+// File formats: point clouds in, meshes and oriented points out. Every reader treats its
+// input as hostile (bounded allocations, every count checked against the bytes present);
+// every writer goes through AtomicFile so a failure never leaves a partial file.
+// Failures throw gmpu::Error with GMPU_ERROR_IO / PARSE / UNSUPPORTED / INVALID_INPUT and
+// a message that names the file and the problem.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace gmpu::io {
+
+struct PointCloud {
+    std::vector<double> positions;  // 3 per point
+    std::vector<double> normals;    // 3 per point, or empty when the file has none
+    size_t size() const { return positions.size() / 3; }
+};
+
+struct MeshData {
+    std::vector<double> vertices;     // 3 per vertex
+    std::vector<uint32_t> triangles;  // 3 per triangle (polygons are fan-triangulated)
+};
+
+// Borrowed arrays to write; normals may be null.
+struct MeshView {
+    const double *vertices = nullptr;
+    size_t vertex_count = 0;
+    const uint32_t *triangles = nullptr;
+    size_t triangle_count = 0;
+    const double *normals = nullptr;
+};
+
+// .ply (ascii, binary_little_endian, binary_big_endian), .xyz/.txt (3 or 6 columns),
+// .off, .obj (vertices only). Format chosen by extension, case-insensitive.
+PointCloud read_points(const std::string &path);
+
+// Vertices and faces of .off, .obj or .ply meshes (used by tests and the benchmark).
+MeshData read_mesh(const std::string &path);
+
+// .ply (binary little-endian, with per-vertex normals when given), .obj, .off.
+void write_mesh(const std::string &path, const MeshView &mesh);
+
+// .ply (binary little-endian; nx ny nz when normals is non-null) or .xyz (ascii).
+void write_points(const std::string &path, const double *xyz, const double *normals,
+                  size_t count);
+
+}  // namespace gmpu::io

@@ -1,0 +1,17 @@
+// The triangle mesh that polygonize produces and the C ABI hands out.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace gmpu {
+
+struct Mesh {
+    std::vector<double> vertices;     // 3 per vertex
+    std::vector<double> normals;      // 3 per vertex (unit, outward), or empty
+    std::vector<uint32_t> triangles;  // 3 per triangle, counter-clockwise seen from outside
+    size_t vertex_count() const { return vertices.size() / 3; }
+    size_t triangle_count() const { return triangles.size() / 3; }
+};
+
+}  // namespace gmpu
