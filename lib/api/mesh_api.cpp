@@ -1,0 +1,95 @@
+// C ABI of meshes: built from caller arrays (or by gmpu_surface_polygonize), queried,
+// written.
+#include <cmath>
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "api/guard.hpp"
+#include "api/handles.hpp"
+#include "gmpu/gmpu.h"
+#include "io/io.hpp"
+
+extern "C" {
+
+GMPU_API gmpu_status gmpu_mesh_create(const double *vertices, size_t vertex_count,
+                                      const uint32_t *triangles, size_t triangle_count,
+                                      gmpu_mesh **out) {
+    using gmpu::Error;
+    return gmpu::api::guarded(nullptr, [&] {
+        gmpu::api::require_arg(out, "out");
+        *out = nullptr;
+        if (vertex_count > SIZE_MAX / (3 * sizeof(double)) || triangle_count > SIZE_MAX / (3 * sizeof(uint32_t)))
+            throw Error(GMPU_ERROR_INVALID_ARGUMENT, "count is too large");
+        if (vertex_count > 0) gmpu::api::require_arg(vertices, "vertices");
+        if (triangle_count > 0) gmpu::api::require_arg(triangles, "triangles");
+        auto mesh = std::make_unique<gmpu_mesh>();
+        mesh->mesh.vertices.assign(vertices, vertices + 3 * vertex_count);
+        for (size_t i = 0; i < mesh->mesh.vertices.size(); ++i)
+            if (!std::isfinite(mesh->mesh.vertices[i]))
+                throw Error(GMPU_ERROR_INVALID_INPUT,
+                            "coordinate of vertex " + std::to_string(i / 3) + " is not finite");
+        mesh->mesh.triangles.assign(triangles, triangles + 3 * triangle_count);
+        for (size_t i = 0; i < mesh->mesh.triangles.size(); ++i)
+            if (mesh->mesh.triangles[i] >= vertex_count)
+                throw Error(GMPU_ERROR_INVALID_INPUT,
+                            "triangle " + std::to_string(i / 3) + " uses vertex index " +
+                                std::to_string(mesh->mesh.triangles[i]) + ", but vertex_count is " +
+                                std::to_string(vertex_count));
+        *out = mesh.release();
+    });
+}
+
+GMPU_API void gmpu_mesh_destroy(gmpu_mesh *mesh) {
+    gmpu::api::guarded(nullptr, [&] { delete mesh; });
+}
+
+GMPU_API size_t gmpu_mesh_vertex_count(const gmpu_mesh *mesh) {
+    size_t n = 0;
+    gmpu::api::guarded(nullptr, [&] { n = mesh ? mesh->mesh.vertex_count() : 0; });
+    return n;
+}
+
+GMPU_API size_t gmpu_mesh_triangle_count(const gmpu_mesh *mesh) {
+    size_t n = 0;
+    gmpu::api::guarded(nullptr, [&] { n = mesh ? mesh->mesh.triangle_count() : 0; });
+    return n;
+}
+
+GMPU_API const double *gmpu_mesh_vertices(const gmpu_mesh *mesh) {
+    const double *p = nullptr;
+    gmpu::api::guarded(nullptr, [&] { p = mesh ? mesh->mesh.vertices.data() : nullptr; });
+    return p;
+}
+
+GMPU_API const double *gmpu_mesh_normals(const gmpu_mesh *mesh) {
+    const double *p = nullptr;
+    gmpu::api::guarded(nullptr, [&] {
+        p = mesh && !mesh->mesh.normals.empty() ? mesh->mesh.normals.data() : nullptr;
+    });
+    return p;
+}
+
+GMPU_API const uint32_t *gmpu_mesh_triangles(const gmpu_mesh *mesh) {
+    const uint32_t *p = nullptr;
+    gmpu::api::guarded(nullptr, [&] { p = mesh ? mesh->mesh.triangles.data() : nullptr; });
+    return p;
+}
+
+GMPU_API gmpu_status gmpu_mesh_write(const gmpu_mesh *mesh, const char *path) {
+    return gmpu::api::guarded(nullptr, [&] {
+        gmpu::api::require_arg(mesh, "mesh");
+        gmpu::api::require_arg(path, "path");
+        const gmpu::Mesh &m = mesh->mesh;
+        gmpu::io::MeshView view;
+        view.vertices = m.vertices.data();
+        view.vertex_count = m.vertex_count();
+        view.triangles = m.triangles.data();
+        view.triangle_count = m.triangle_count();
+        // A mesh's normals are per vertex; without a full set, write none.
+        view.normals = m.normals.size() == m.vertices.size() && !m.normals.empty() ? m.normals.data() : nullptr;
+        gmpu::io::write_mesh(path, view);
+    });
+}
+
+}  // extern "C"

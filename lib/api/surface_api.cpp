@@ -1,0 +1,384 @@
+// The C ABI of gmpu_surface: a state machine over the pipeline's stages
+// (points → fitted → oriented), each verb checking that the stage before it is done.
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <memory>
+#include <string>
+
+#include "api/guard.hpp"
+#include "api/handles.hpp"
+#include "core/parallel.hpp"
+#include "core/params.hpp"
+#include "core/progress.hpp"
+#include "fit/build_octree.hpp"
+#include "geometry/point_set.hpp"
+#include "implicit/mpu_function.hpp"
+#include "implicit/surface_field.hpp"
+#include "implicit/winding_field.hpp"
+#include "mesh/polygonizer.hpp"
+#include "orient/orient.hpp"
+
+using gmpu::Error;
+using gmpu::api::guarded;
+using gmpu::api::require_arg;
+
+struct gmpu_surface {
+    enum class Stage { empty, points, fitted, oriented };
+    Stage stage = Stage::empty;
+    gmpu::Params params;
+    gmpu::PointSet points;
+    std::vector<float> input_normals;  // unit, 3 per point; empty when none were given
+    gmpu::Octree tree;
+    gmpu::PointMeasures measures;      // oriented normals, areas, trust radii per point
+    gmpu::WindingField winding;        // built from the measures; signs far regions
+    gmpu_progress_fn progress_fn = nullptr;
+    void *progress_user = nullptr;
+    std::string last_error;
+    gmpu::OrientStats orient_stats;
+    double seconds[4] = {0, 0, 0, 0};  // by gmpu_stage
+    int last_resolution = 0;
+
+    void discard_fit() {
+        if (stage > Stage::points) stage = Stage::points;
+        tree = gmpu::Octree();
+        measures = gmpu::PointMeasures();
+        winding = gmpu::WindingField();
+        orient_stats = {};
+    }
+    void require(Stage needed, const char *verb, const char *missing) const {
+        if (stage < needed)
+            throw Error(GMPU_ERROR_WRONG_ORDER, std::string(verb) + " needs " + missing + " first");
+    }
+};
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+struct ParamSpec {
+    double lo, hi;
+    bool integer;
+    bool refits;  // changing it discards the fit
+    const char *name;
+};
+
+ParamSpec spec(gmpu_param key) {
+    switch (key) {
+        case GMPU_PARAM_ERROR: return {0.0, 1.0, false, true, "GMPU_PARAM_ERROR"};
+        case GMPU_PARAM_MAX_DEPTH: return {1, gmpu::kMaxDepth, true, true, "GMPU_PARAM_MAX_DEPTH"};
+        case GMPU_PARAM_MIN_POINTS: return {6, 1000, true, true, "GMPU_PARAM_MIN_POINTS"};
+        case GMPU_PARAM_SUPPORT_SCALE: return {0.5, 2.0, false, true, "GMPU_PARAM_SUPPORT_SCALE"};
+        case GMPU_PARAM_SHARP_FEATURES: return {0, 1, true, true, "GMPU_PARAM_SHARP_FEATURES"};
+        case GMPU_PARAM_RESOLUTION: return {0, 4096, true, false, "GMPU_PARAM_RESOLUTION"};
+        case GMPU_PARAM_LEVEL: return {0, gmpu::kMaxDepth, true, false, "GMPU_PARAM_LEVEL"};
+        case GMPU_PARAM_THREADS: return {0, 1024, true, false, "GMPU_PARAM_THREADS"};
+        case GMPU_PARAM_MAX_CELLS: return {1, 1e9, true, true, "GMPU_PARAM_MAX_CELLS"};
+        case GMPU_PARAM_MAX_TRIANGLES: return {1, 2e9, true, false, "GMPU_PARAM_MAX_TRIANGLES"};
+    }
+    throw Error(GMPU_ERROR_INVALID_ARGUMENT, "unknown parameter key " + std::to_string(int(key)));
+}
+
+double *param_slot(gmpu::Params &p, gmpu_param key, double &scratch) {
+    switch (key) {
+        case GMPU_PARAM_ERROR: return &p.error;
+        case GMPU_PARAM_SUPPORT_SCALE: return &p.support_scale;
+        case GMPU_PARAM_MAX_CELLS: return &p.max_cells;
+        case GMPU_PARAM_MAX_TRIANGLES: return &p.max_triangles;
+        default: return &scratch;  // integer-valued: converted by the caller
+    }
+}
+
+double get_param(const gmpu::Params &p, gmpu_param key) {
+    switch (key) {
+        case GMPU_PARAM_ERROR: return p.error;
+        case GMPU_PARAM_MAX_DEPTH: return p.max_depth;
+        case GMPU_PARAM_MIN_POINTS: return p.min_points;
+        case GMPU_PARAM_SUPPORT_SCALE: return p.support_scale;
+        case GMPU_PARAM_SHARP_FEATURES: return p.sharp_features ? 1 : 0;
+        case GMPU_PARAM_RESOLUTION: return p.resolution;
+        case GMPU_PARAM_LEVEL: return p.level;
+        case GMPU_PARAM_THREADS: return p.threads;
+        case GMPU_PARAM_MAX_CELLS: return p.max_cells;
+        case GMPU_PARAM_MAX_TRIANGLES: return p.max_triangles;
+    }
+    throw Error(GMPU_ERROR_INVALID_ARGUMENT, "unknown parameter key " + std::to_string(int(key)));
+}
+
+void set_param(gmpu::Params &p, gmpu_param key, double value) {
+    ParamSpec s = spec(key);
+    bool open_low = key == GMPU_PARAM_ERROR;  // ε must be positive
+    if (!std::isfinite(value) || value < s.lo || value > s.hi || (open_low && value <= s.lo) ||
+        (key == GMPU_PARAM_ERROR && value >= s.hi) || (s.integer && value != std::floor(value)))
+        throw Error(GMPU_ERROR_INVALID_ARGUMENT,
+                    std::string(s.name) + " = " + std::to_string(value) + " is out of range: expected " +
+                        (s.integer ? "an integer " : "a number ") + (open_low ? "in (" : "in [") +
+                        std::to_string(s.lo) + ", " + std::to_string(s.hi) + (key == GMPU_PARAM_ERROR ? ")" : "]"));
+    if (key == GMPU_PARAM_RESOLUTION && value > 0 && value < 8)
+        throw Error(GMPU_ERROR_INVALID_ARGUMENT, "GMPU_PARAM_RESOLUTION must be 0 (automatic) or 8..4096");
+    double scratch = 0;
+    *param_slot(p, key, scratch) = value;
+    switch (key) {
+        case GMPU_PARAM_MAX_DEPTH: p.max_depth = int(value); break;
+        case GMPU_PARAM_MIN_POINTS: p.min_points = int(value); break;
+        case GMPU_PARAM_SHARP_FEATURES: p.sharp_features = value != 0; break;
+        case GMPU_PARAM_RESOLUTION: p.resolution = int(value); break;
+        case GMPU_PARAM_LEVEL: p.level = int(value); break;
+        case GMPU_PARAM_THREADS: p.threads = unsigned(value); break;
+        default: break;
+    }
+}
+
+void check_array(const void *data, size_t count, size_t stride, size_t element, const char *what) {
+    require_arg(data, what);
+    if (stride != 0 && stride < element)
+        throw Error(GMPU_ERROR_INVALID_ARGUMENT, std::string(what) + " stride " + std::to_string(stride) +
+                                                     " is smaller than one point (" + std::to_string(element) +
+                                                     " bytes)");
+    size_t s = stride ? stride : element;
+    if (count > std::numeric_limits<size_t>::max() / s || count > std::numeric_limits<uint32_t>::max() / 4)
+        throw Error(GMPU_ERROR_INVALID_ARGUMENT, std::string(what) + ": too many points");
+}
+
+template <class T>
+gmpu_status set_points(gmpu_surface *s, const T *xyz, size_t count, size_t stride) {
+    return guarded(s ? &s->last_error : nullptr, [&] {
+        require_arg(s, "surface");
+        check_array(xyz, count, stride, 3 * sizeof(T), "xyz");
+        gmpu::PointSet points = gmpu::PointSet::from_array(xyz, count, stride, size_t(s->params.min_points));
+        s->discard_fit();
+        s->points = std::move(points);
+        s->input_normals.clear();
+        s->stage = gmpu_surface::Stage::points;
+    });
+}
+
+template <class T>
+gmpu_status set_normals(gmpu_surface *s, const T *nxyz, size_t count, size_t stride) {
+    return guarded(s ? &s->last_error : nullptr, [&] {
+        require_arg(s, "surface");
+        s->require(gmpu_surface::Stage::points, "gmpu_surface_set_normals", "gmpu_surface_set_points");
+        check_array(nxyz, count, stride, 3 * sizeof(T), "nxyz");
+        if (count != s->points.size())
+            throw Error(GMPU_ERROR_INVALID_INPUT, std::to_string(count) + " normals given for " +
+                                                      std::to_string(s->points.size()) + " points");
+        if (stride == 0) stride = 3 * sizeof(T);
+        std::vector<float> unit(3 * count);
+        const auto *bytes = reinterpret_cast<const unsigned char *>(nxyz);
+        for (size_t i = 0; i < count; ++i) {
+            T v[3];
+            std::memcpy(v, bytes + i * stride, sizeof v);
+            Eigen::Vector3d n{double(v[0]), double(v[1]), double(v[2])};
+            double len = n.norm();
+            if (!n.allFinite() || !std::isfinite(len) || !(len > 0.0))
+                throw Error(GMPU_ERROR_INVALID_INPUT,
+                            "normal " + std::to_string(i) + " is " + (n.allFinite() ? "zero" : "NaN or infinite"));
+            for (int d = 0; d < 3; ++d) unit[3 * i + d] = float(n[d] / len);
+        }
+        s->input_normals.swap(unit);
+        if (s->stage > gmpu_surface::Stage::fitted) s->stage = gmpu_surface::Stage::fitted;
+    });
+}
+
+}  // namespace
+
+extern "C" {
+
+GMPU_API gmpu_status gmpu_surface_create(gmpu_surface **out) {
+    return guarded(nullptr, [&] {
+        require_arg(out, "out");
+        *out = nullptr;
+        *out = new gmpu_surface();
+    });
+}
+
+GMPU_API void gmpu_surface_destroy(gmpu_surface *s) { delete s; }
+
+GMPU_API const char *gmpu_surface_last_error(const gmpu_surface *s) { return s ? s->last_error.c_str() : ""; }
+
+GMPU_API gmpu_status gmpu_surface_set_param(gmpu_surface *s, gmpu_param key, double value) {
+    return guarded(s ? &s->last_error : nullptr, [&] {
+        require_arg(s, "surface");
+        gmpu::Params p = s->params;
+        set_param(p, key, value);
+        if (spec(key).refits && get_param(p, key) != get_param(s->params, key)) s->discard_fit();
+        s->params = p;
+    });
+}
+
+GMPU_API gmpu_status gmpu_surface_get_param(const gmpu_surface *s, gmpu_param key, double *value) {
+    return guarded(nullptr, [&] {
+        require_arg(s, "surface");
+        require_arg(value, "value");
+        *value = get_param(s->params, key);
+    });
+}
+
+GMPU_API gmpu_status gmpu_surface_get_stat(const gmpu_surface *s, gmpu_stat key, double *value) {
+    return guarded(nullptr, [&] {
+        require_arg(s, "surface");
+        require_arg(value, "value");
+        const auto &cells = s->tree.cells;
+        auto leaves_where = [&](auto pred) {
+            double n = 0;
+            for (const auto &c : cells) n += c.is_leaf() && pred(c);
+            return n;
+        };
+        switch (key) {
+            case GMPU_STAT_POINTS: *value = double(s->points.size()); break;
+            case GMPU_STAT_CELLS: *value = double(cells.size()); break;
+            case GMPU_STAT_LEAVES: *value = leaves_where([](const gmpu::Cell &) { return true; }); break;
+            case GMPU_STAT_DEPTH: {
+                int d = 0;
+                for (const auto &c : cells) d = std::max<int>(d, c.depth);
+                *value = d;
+                break;
+            }
+            case GMPU_STAT_QUADRIC_CELLS:
+                *value = leaves_where([](const gmpu::Cell &c) { return c.shape.model == gmpu::Model::quadric; });
+                break;
+            case GMPU_STAT_BIVARIATE_CELLS:
+                *value = leaves_where([](const gmpu::Cell &c) { return c.shape.model == gmpu::Model::bivariate; });
+                break;
+            case GMPU_STAT_PIECEWISE_CELLS:
+                *value = leaves_where([](const gmpu::Cell &c) { return c.shape.piece >= 0; });
+                break;
+            case GMPU_STAT_COMPONENTS: *value = s->orient_stats.components; break;
+            case GMPU_STAT_FLIPPED_CELLS: *value = s->orient_stats.flipped_leaves; break;
+            case GMPU_STAT_FIT_SECONDS: *value = s->seconds[GMPU_STAGE_FIT]; break;
+            case GMPU_STAT_ORIENT_SECONDS: *value = s->seconds[GMPU_STAGE_ORIENT]; break;
+            case GMPU_STAT_POLYGONIZE_SECONDS: *value = s->seconds[GMPU_STAGE_POLYGONIZE]; break;
+            case GMPU_STAT_RESOLUTION: *value = s->last_resolution; break;
+            case GMPU_STAT_BBOX_DIAGONAL: *value = s->points.empty() ? 0.0 : s->points.world_diagonal(); break;
+            default: throw Error(GMPU_ERROR_INVALID_ARGUMENT, "unknown statistic key " + std::to_string(int(key)));
+        }
+    });
+}
+
+GMPU_API gmpu_status gmpu_surface_set_progress(gmpu_surface *s, gmpu_progress_fn fn, void *user) {
+    return guarded(s ? &s->last_error : nullptr, [&] {
+        require_arg(s, "surface");
+        s->progress_fn = fn;
+        s->progress_user = user;
+    });
+}
+
+GMPU_API gmpu_status gmpu_surface_set_points_f64(gmpu_surface *s, const double *xyz, size_t count, size_t stride) {
+    return set_points(s, xyz, count, stride);
+}
+GMPU_API gmpu_status gmpu_surface_set_points_f32(gmpu_surface *s, const float *xyz, size_t count, size_t stride) {
+    return set_points(s, xyz, count, stride);
+}
+GMPU_API gmpu_status gmpu_surface_set_normals_f64(gmpu_surface *s, const double *n, size_t count, size_t stride) {
+    return set_normals(s, n, count, stride);
+}
+GMPU_API gmpu_status gmpu_surface_set_normals_f32(gmpu_surface *s, const float *n, size_t count, size_t stride) {
+    return set_normals(s, n, count, stride);
+}
+
+GMPU_API size_t gmpu_surface_point_count(const gmpu_surface *s) { return s ? s->points.size() : 0; }
+
+GMPU_API gmpu_status gmpu_surface_fit(gmpu_surface *s) {
+    return guarded(s ? &s->last_error : nullptr, [&] {
+        require_arg(s, "surface");
+        s->require(gmpu_surface::Stage::points, "gmpu_surface_fit", "gmpu_surface_set_points");
+        auto t0 = Clock::now();
+        gmpu::Progress progress(s->progress_fn, s->progress_user, GMPU_STAGE_FIT);
+        progress.report(0.0, true);
+        gmpu::Octree tree = gmpu::build_octree(s->points, s->params, progress);
+        s->discard_fit();
+        s->tree = std::move(tree);
+        s->stage = gmpu_surface::Stage::fitted;
+        s->seconds[GMPU_STAGE_FIT] = since(t0);
+    });
+}
+
+GMPU_API gmpu_status gmpu_surface_orient(gmpu_surface *s) {
+    return guarded(s ? &s->last_error : nullptr, [&] {
+        require_arg(s, "surface");
+        s->require(gmpu_surface::Stage::fitted, "gmpu_surface_orient", "gmpu_surface_fit");
+        auto t0 = Clock::now();
+        gmpu::Progress progress(s->progress_fn, s->progress_user, GMPU_STAGE_ORIENT);
+        progress.report(0.0, true);
+        // Orient only writes the cells' signs and resets them first, so a cancelled or failed
+        // orient leaves a fit that the next orient can use as it is.
+        s->stage = gmpu_surface::Stage::fitted;
+        s->winding = gmpu::WindingField();
+        gmpu::Octree &tree = s->tree;
+        gmpu::OrientStats stats = gmpu::orient_octree(
+            tree, s->points, s->input_normals.empty() ? nullptr : s->input_normals.data(), s->params, progress);
+        gmpu::MpuFunction f(tree, 0);
+        const unsigned threads = gmpu::resolve_threads(s->params.threads);
+        gmpu::PointMeasures measures;
+        measures.normals = gmpu::point_normals(f, s->points, threads, progress,
+                                               0.9 * double(s->points.size()) / 0.05,
+                                               double(s->points.size()) / 0.05);
+        gmpu::measure_points(s->points, threads, progress, measures);
+        s->measures = std::move(measures);
+        s->winding = gmpu::WindingField(tree, s->points, s->measures.normals, s->measures.area);
+        progress.report(1.0, true);
+        s->orient_stats = stats;
+        s->stage = gmpu_surface::Stage::oriented;
+        s->seconds[GMPU_STAGE_ORIENT] = since(t0);
+    });
+}
+
+GMPU_API gmpu_status gmpu_surface_evaluate(const gmpu_surface *s, const double *xyz, size_t count, double *values,
+                                           double *gradients) {
+    return guarded(nullptr, [&] {
+        require_arg(s, "surface");
+        if (count > 0) require_arg(xyz, "xyz");
+        if (!values && !gradients) throw Error(GMPU_ERROR_INVALID_ARGUMENT, "values and gradients are both NULL");
+        s->require(gmpu_surface::Stage::oriented, "gmpu_surface_evaluate", "gmpu_surface_orient");
+        for (size_t i = 0; i < 3 * count; ++i)
+            if (!std::isfinite(xyz[i]))
+                throw Error(GMPU_ERROR_INVALID_INPUT, "query point " + std::to_string(i / 3) + " is NaN or infinite");
+        const gmpu::MpuFunction mpu(s->tree, s->params.level);
+        const gmpu::SurfaceField f(mpu, s->points, s->measures);
+        const gmpu::Normalisation &norm = s->points.normalisation();
+        Eigen::Vector3d g;
+        for (size_t i = 0; i < count; ++i) {
+            Eigen::Vector3d q = norm.to_unit(Eigen::Vector3d(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]));
+            double v = f.value(q, gradients ? &g : nullptr);
+            if (values) values[i] = v / norm.scale;
+            if (gradients)
+                for (int d = 0; d < 3; ++d) gradients[3 * i + d] = g[d];
+        }
+    });
+}
+
+GMPU_API gmpu_status gmpu_surface_copy_normals(const gmpu_surface *s, double *out, size_t count) {
+    return guarded(nullptr, [&] {
+        require_arg(s, "surface");
+        require_arg(out, "out");
+        s->require(gmpu_surface::Stage::oriented, "gmpu_surface_copy_normals", "gmpu_surface_orient");
+        if (count != s->points.size())
+            throw Error(GMPU_ERROR_INVALID_ARGUMENT, "count " + std::to_string(count) + " differs from the " +
+                                                         std::to_string(s->points.size()) + " points");
+        for (size_t i = 0; i < 3 * count; ++i) out[i] = double(s->measures.normals[i]);
+    });
+}
+
+GMPU_API gmpu_status gmpu_surface_polygonize(gmpu_surface *s, gmpu_mesh **out) {
+    return guarded(s ? &s->last_error : nullptr, [&] {
+        require_arg(s, "surface");
+        require_arg(out, "out");
+        *out = nullptr;
+        s->require(gmpu_surface::Stage::oriented, "gmpu_surface_polygonize", "gmpu_surface_orient");
+        auto t0 = Clock::now();
+        gmpu::Progress progress(s->progress_fn, s->progress_user, GMPU_STAGE_POLYGONIZE);
+        progress.report(0.0, true);
+        int resolution = s->params.resolution > 0 ? s->params.resolution : gmpu::default_resolution(s->tree, s->points);
+        const gmpu::MpuFunction mpu(s->tree, s->params.level);
+        const gmpu::SurfaceField f(mpu, s->points, s->measures);
+        auto mesh = std::make_unique<gmpu_mesh>();
+        mesh->mesh = gmpu::polygonize(f, s->winding, s->points, s->measures, resolution, s->params, progress);
+        s->last_resolution = resolution;
+        s->seconds[GMPU_STAGE_POLYGONIZE] = since(t0);
+        *out = mesh.release();
+    });
+}
+
+}  // extern "C"

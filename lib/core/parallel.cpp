@@ -1,0 +1,69 @@
+#include "core/parallel.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <atomic>
+#include <exception>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+namespace gmpu {
+
+unsigned resolve_threads(unsigned requested) {
+    if (requested > 0) return requested;
+    unsigned hw = std::thread::hardware_concurrency();
+    return hw > 0 ? hw : 1;
+}
+
+void parallel_for(size_t begin, size_t end, unsigned threads, Progress &progress,
+                  const std::function<void(size_t)> &body, double done_before, double total,
+                  size_t chunk) {
+    if (begin >= end) return;
+    chunk = std::max<size_t>(1, chunk);
+    std::atomic<size_t> next{begin};
+    std::atomic<size_t> finished{0};
+    std::atomic<unsigned> active{0};
+    std::exception_ptr failure;
+    std::mutex failure_mutex;
+
+    auto work = [&](bool is_caller) {
+        for (;;) {
+            if (progress.cancelled()) return;
+            size_t start = next.fetch_add(chunk);
+            if (start >= end) return;
+            size_t stop = std::min(end, start + chunk);
+            try {
+                for (size_t i = start; i < stop; ++i) body(i);
+            } catch (...) {
+                std::lock_guard<std::mutex> lock(failure_mutex);
+                if (!failure) failure = std::current_exception();
+                progress.cancel();  // stop the others; the first failure wins
+                return;
+            }
+            size_t done = finished.fetch_add(stop - start) + (stop - start);
+            if (is_caller && total > 0) progress.report((done_before + double(done)) / total);
+        }
+    };
+
+    unsigned n = std::max(1u, std::min<unsigned>(threads, unsigned((end - begin + chunk - 1) / chunk)));
+    std::vector<std::thread> pool;
+    pool.reserve(n - 1);
+    active.store(n - 1);
+    for (unsigned t = 1; t < n; ++t)
+        pool.emplace_back([&] {
+            work(false);
+            active.fetch_sub(1);
+        });
+    work(true);
+    // The caller keeps reporting (and so keeps cancellation responsive) while the last
+    // chunks finish on the other threads.
+    while (active.load() > 0) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+        if (total > 0) progress.report((done_before + double(finished.load())) / total);
+    }
+    for (auto &t : pool) t.join();
+    if (failure) std::rethrow_exception(failure);
+}
+
+}  // namespace gmpu

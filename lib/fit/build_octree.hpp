@@ -1,0 +1,20 @@
+// Fit stage: the adaptive MPU octree over the points. Each cell's support ball (radius
+// α × cell diagonal, grown until it holds N_min points) gets a local shape function; a cell
+// is subdivided while its Taubin error exceeds ε, it is shallower than the maximum depth,
+// and its ungrown ball still holds N_min points (below that scale children would only
+// refit the same points). Only cells near the data are created (a point in the cube or
+// within one cell size of its centre), so the tree follows the data and every leaf is
+// non-empty.
+#pragma once
+
+#include "core/params.hpp"
+#include "core/progress.hpp"
+#include "geometry/octree.hpp"
+#include "geometry/point_set.hpp"
+
+namespace gmpu {
+
+// Throws CANCELLED or LIMIT_EXCEEDED (GMPU_PARAM_MAX_CELLS).
+Octree build_octree(const PointSet &points, const Params &params, Progress &progress);
+
+}  // namespace gmpu

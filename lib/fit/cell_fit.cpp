@@ -1,0 +1,48 @@
+#include "fit/cell_fit.hpp"
+
+#include "fit/piecewise_fit.hpp"
+
+namespace gmpu {
+
+namespace {
+// Large supports (coarse cells) are fitted on an even subsample: the fit of a coarse cell
+// only has to be roughly right, and its error is still measured on every point.
+constexpr size_t kMaxFitPoints = 2048;
+
+const PointList &fit_sample(const PointList &support, PointList &buffer) {
+    if (support.size() <= kMaxFitPoints) return support;
+    buffer.clear();
+    double step = double(support.size()) / double(kMaxFitPoints);
+    for (size_t k = 0; k < kMaxFitPoints; ++k) buffer.push_back(support[size_t(double(k) * step)]);
+    return buffer;
+}
+}  // namespace
+
+CellFit fit_cell(const PointList &support, double radius, double epsilon, const Params &params) {
+    thread_local PointList sample_buffer;
+    const PointList &sample = fit_sample(support, sample_buffer);
+    static const std::vector<PiecewiseShape> no_pieces;
+
+    CellFit fit;
+    Pca pca = compute_pca(sample);
+    fit.variation = pca.variation;
+    if (pca.variation > kVariationThreshold) {
+        fit.shape.model = Model::quadric;
+        fit.shape.q = fit_general_quadric(sample, radius);
+    } else {
+        fit.shape.model = Model::bivariate;
+        fit.shape.q = fit_bivariate(sample, pca, radius);
+    }
+    fit.error = taubin_error(fit.shape, no_pieces, support);
+
+    if (fit.error > epsilon && params.sharp_features) {
+        CellFit sharp;
+        if (fit_piecewise(support, radius, epsilon, sharp) && sharp.error < fit.error) {
+            sharp.variation = fit.variation;
+            return sharp;
+        }
+    }
+    return fit;
+}
+
+}  // namespace gmpu

@@ -1,0 +1,62 @@
+// The adaptive octree of MPU: cells with a centre, a spherical support and a local shape
+// function. Built by fit (lib/fit/build_octree.cpp), signed by orient, read by the implicit
+// function and the polygonizer. The root is the cube of 1.2 × the longest side of the
+// normalised bounding box (which is 1), centred at the origin.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "fit/local_shape.hpp"
+
+namespace gmpu {
+
+constexpr double kRootSize = 1.2;
+constexpr int kMaxDepth = 16;  // integer cell coordinates fit in 16 bits
+
+struct Cell {
+    Eigen::Vector3d centre;
+    double size = 0.0;     // edge length
+    double radius = 0.0;   // support radius R (after growing to hold N_min points)
+    uint16_t coord[3] = {0, 0, 0};  // integer position among the cells of its depth
+    uint8_t depth = 0;
+    uint8_t child_mask = 0;          // which of the 8 octants have a child
+    int32_t first_child = -1;        // children are stored contiguously, in octant order
+    int32_t parent = -1;
+    uint32_t point_begin = 0, point_end = 0;  // points inside the cube: Octree::order range
+    uint32_t support_count = 0;       // points used by the fit
+    uint32_t initial_count = 0;       // points in the ungrown ball (capped at N_min)
+    float error = 0.0f;               // Taubin distance error of the fit (normalised units)
+    float variation = 0.0f;           // PCA surface variation σ of the support
+    int8_t sign = 1;                  // orientation label ℓ_i applied to the shape
+    bool oriented = false;
+    LocalShape shape;
+
+    bool is_leaf() const { return child_mask == 0; }
+    double value(const Eigen::Vector3d &x, const std::vector<PiecewiseShape> &pieces,
+                 Eigen::Vector3d *gradient) const {
+        double v = shape.value(x - centre, pieces, gradient);
+        if (sign < 0) {
+            if (gradient) *gradient = -*gradient;
+            return -v;
+        }
+        return v;
+    }
+};
+
+struct Octree {
+    std::vector<Cell> cells;             // cells[0] is the root; parents before children
+    std::vector<PiecewiseShape> pieces;  // piecewise shapes referenced by cells
+    std::vector<uint32_t> order;         // point indices, grouped by cell (Cell::point_begin)
+
+    bool empty() const { return cells.empty(); }
+    // Index of the child in `octant` (bit 0: +x, bit 1: +y, bit 2: +z), or -1.
+    int32_t child(const Cell &c, int octant) const {
+        if (!(c.child_mask & (1u << octant))) return -1;
+        return c.first_child + __builtin_popcount(c.child_mask & ((1u << octant) - 1u));
+    }
+};
+
+}  // namespace gmpu

@@ -1,0 +1,171 @@
+#include "geometry/point_set.hpp"
+
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include <Eigen/Eigenvalues>
+#include <nanoflann.hpp>
+
+#include "core/error.hpp"
+
+namespace gmpu {
+
+namespace {
+
+// nanoflann reads the points in place through this adaptor (no copy). It holds the
+// buffer, not the vector, so moving the PointSet (which keeps the buffer) keeps it valid.
+struct CloudAdaptor {
+    const float *pts;
+    size_t count;
+    size_t kdtree_get_point_count() const { return count; }
+    float kdtree_get_pt(size_t i, size_t dim) const { return pts[3 * i + dim]; }
+    template <class Box>
+    bool kdtree_get_bbox(Box &) const { return false; }
+};
+
+using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, CloudAdaptor>,
+                                                   CloudAdaptor, 3, uint32_t>;
+
+// Counts points inside a radius and stops the search once `enough` are seen.
+struct CountingResultSet {
+    float radius_sq;
+    size_t enough;
+    size_t count = 0;
+    void init() {}
+    void clear() { count = 0; }
+    size_t size() const { return count; }
+    bool full() const { return true; }
+    bool addPoint(float dist, uint32_t) {
+        if (dist < radius_sq) ++count;
+        return count < enough;
+    }
+    float worstDist() const { return radius_sq; }
+};
+
+// Appends indices of points inside a radius, without nanoflann's pair vector.
+struct CollectingResultSet {
+    float radius_sq;
+    std::vector<uint32_t> *out;
+    void init() {}
+    void clear() {}
+    size_t size() const { return out->size(); }
+    bool full() const { return true; }
+    bool addPoint(float dist, uint32_t index) {
+        if (dist < radius_sq) out->push_back(index);
+        return true;
+    }
+    float worstDist() const { return radius_sq; }
+};
+
+}  // namespace
+
+struct PointSet::Index {
+    CloudAdaptor adaptor;
+    KdTree tree;
+    explicit Index(const std::vector<float> &pts)
+        : adaptor{pts.data(), pts.size() / 3}, tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {
+        tree.buildIndex();
+    }
+};
+
+PointSet::PointSet() = default;
+PointSet::PointSet(PointSet &&) noexcept = default;
+PointSet &PointSet::operator=(PointSet &&) noexcept = default;
+PointSet::~PointSet() = default;
+
+template <class T>
+PointSet PointSet::from_array(const T *xyz, size_t count, size_t stride, size_t min_points) {
+    if (stride == 0) stride = 3 * sizeof(T);
+    if (count < min_points)
+        throw Error(GMPU_ERROR_INVALID_INPUT,
+                    std::to_string(count) + " points given; at least " + std::to_string(min_points) +
+                        " are needed (GMPU_PARAM_MIN_POINTS) to fit a surface");
+    const auto *bytes = reinterpret_cast<const unsigned char *>(xyz);
+    auto read = [&](size_t i) {
+        T v[3];
+        std::memcpy(v, bytes + i * stride, sizeof v);  // stride need not keep alignment
+        return Eigen::Vector3d(double(v[0]), double(v[1]), double(v[2]));
+    };
+
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
+    for (size_t i = 0; i < count; ++i) {
+        Eigen::Vector3d p = read(i);
+        if (!p.allFinite())
+            throw Error(GMPU_ERROR_INVALID_INPUT, "point " + std::to_string(i) +
+                                                      " has a NaN or infinite coordinate");
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+    }
+    Eigen::Vector3d extent = hi - lo;
+    double longest = extent.maxCoeff();
+    double magnitude = std::max(lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff());
+    if (!(longest > 0.0) || !std::isfinite(longest) || longest <= magnitude * 1e-12)
+        throw Error(GMPU_ERROR_DEGENERATE_INPUT,
+                    "all points are identical (to 12 digits): they bound no volume");
+
+    PointSet set;
+    set.norm_.centre = 0.5 * (lo + hi);
+    set.norm_.scale = 1.0 / longest;
+    set.world_diagonal_ = extent.norm();
+    set.box_min_ = set.norm_.to_unit(lo);
+    set.box_max_ = set.norm_.to_unit(hi);
+    set.points_.resize(3 * count);
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (size_t i = 0; i < count; ++i) {
+        Eigen::Vector3d q = set.norm_.to_unit(read(i));
+        for (int d = 0; d < 3; ++d) set.points_[3 * i + d] = float(q[d]);
+        mean += q;
+    }
+    mean /= double(count);
+
+    // Collinear or coplanar points enclose no volume: say so instead of meshing noise.
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (size_t i = 0; i < count; ++i) {
+        Eigen::Vector3d d = set.point(i) - mean;
+        cov.noalias() += d * d.transpose();
+    }
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov / double(count), Eigen::EigenvaluesOnly);
+    Eigen::Vector3d ev = eig.eigenvalues().cwiseMax(0.0);  // increasing
+    // Thickness relative to the longest side (1 after normalisation); float storage limits
+    // resolution to ~1e-7, so anything thinner than 1e-6 is flat for our purposes.
+    if (std::sqrt(ev[1]) < 1e-6)
+        throw Error(GMPU_ERROR_DEGENERATE_INPUT,
+                    "all points are collinear: they bound no volume");
+    if (std::sqrt(ev[0]) < 1e-6)
+        throw Error(GMPU_ERROR_DEGENERATE_INPUT,
+                    "all points are coplanar (an open flat patch): no closed surface encloses a volume");
+    set.build_index();
+    return set;
+}
+
+template PointSet PointSet::from_array<double>(const double *, size_t, size_t, size_t);
+template PointSet PointSet::from_array<float>(const float *, size_t, size_t, size_t);
+
+void PointSet::build_index() { index_ = std::make_unique<Index>(points_); }
+
+void PointSet::within(const Eigen::Vector3d &c, double radius, std::vector<uint32_t> &out) const {
+    const float q[3] = {float(c[0]), float(c[1]), float(c[2])};
+    CollectingResultSet rs{float(radius * radius), &out};
+    index_->tree.findNeighbors(rs, q, nanoflann::SearchParams(32, 0.0f, false));
+}
+
+size_t PointSet::count_within(const Eigen::Vector3d &c, double radius, size_t enough) const {
+    const float q[3] = {float(c[0]), float(c[1]), float(c[2])};
+    CountingResultSet rs{float(radius * radius), enough};
+    index_->tree.findNeighbors(rs, q, nanoflann::SearchParams(32, 0.0f, false));
+    return rs.count;
+}
+
+void PointSet::nearest(const Eigen::Vector3d &c, size_t k, std::vector<uint32_t> &indices,
+                       std::vector<float> &squared_distances) const {
+    k = std::min(k, size());
+    indices.resize(k);
+    squared_distances.resize(k);
+    const float q[3] = {float(c[0]), float(c[1]), float(c[2])};
+    size_t found = index_->tree.knnSearch(q, k, indices.data(), squared_distances.data());
+    indices.resize(found);
+    squared_distances.resize(found);
+}
+
+}  // namespace gmpu

@@ -1,0 +1,65 @@
+#include "implicit/winding_field.hpp"
+
+#include <cmath>
+
+namespace gmpu {
+
+namespace {
+constexpr double kFarRatio = 2.0;  // a cell is far when q is beyond twice its radius
+constexpr double kInv4Pi = 0.25 / M_PI;
+}  // namespace
+
+WindingField::WindingField(const Octree &tree, const PointSet &points, const std::vector<float> &normals,
+                           const std::vector<float> &area)
+    : tree_(&tree), points_(&points), moments_(tree.cells.size()), weighted_(points.size()) {
+    for (size_t k = 0; k < tree.order.size(); ++k) {
+        uint32_t i = tree.order[k];
+        weighted_[k] = area[i] * Eigen::Vector3f(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);
+    }
+    // Children follow parents, so a reverse sweep could aggregate; a direct pass over each
+    // cell's contiguous point range is as simple and costs O(n · depth).
+    for (size_t c = 0; c < tree.cells.size(); ++c) {
+        const Cell &cell = tree.cells[c];
+        Moment &m = moments_[c];
+        double total = 0.0;
+        for (uint32_t k = cell.point_begin; k < cell.point_end; ++k) {
+            double a = double(area[tree.order[k]]);
+            m.centroid += a * points.point(tree.order[k]);
+            m.dipole += weighted_[k].cast<double>();
+            total += a;
+        }
+        if (total <= 0.0) continue;
+        m.centroid /= total;
+        for (uint32_t k = cell.point_begin; k < cell.point_end; ++k)
+            m.radius = std::max(m.radius, (points.point(tree.order[k]) - m.centroid).norm());
+    }
+}
+
+double WindingField::visit(uint32_t index, const Eigen::Vector3d &q) const {
+    const Cell &c = tree_->cells[index];
+    if (c.point_end == c.point_begin) return 0.0;
+    const Moment &m = moments_[index];
+    Eigen::Vector3d r = m.centroid - q;
+    double d2 = r.squaredNorm();
+    if (d2 > kFarRatio * kFarRatio * m.radius * m.radius)
+        return kInv4Pi * m.dipole.dot(r) / (d2 * std::sqrt(d2));
+    if (c.is_leaf()) {
+        double w = 0.0;
+        for (uint32_t k = c.point_begin; k < c.point_end; ++k) {
+            Eigen::Vector3d rp = points_->point(tree_->order[k]) - q;
+            double e2 = rp.squaredNorm();
+            if (e2 > 1e-24) w += kInv4Pi * weighted_[k].cast<double>().dot(rp) / (e2 * std::sqrt(e2));
+        }
+        return w;
+    }
+    double w = 0.0;
+    for (int o = 0; o < 8; ++o) {
+        int32_t k = tree_->child(c, o);
+        if (k >= 0) w += visit(uint32_t(k), q);
+    }
+    return w;
+}
+
+double WindingField::winding(const Eigen::Vector3d &q) const { return moments_.empty() ? 0.0 : visit(0, q); }
+
+}  // namespace gmpu

@@ -1,0 +1,40 @@
+// Generalized winding number of the oriented input points (Barill et al. 2018), evaluated
+// hierarchically over the octree: far cells act as one dipole Σ A n at their centroid,
+// near leaves sum their points exactly. It is about 1 inside the reconstructed solid and 0
+// outside — even across holes in the data — and gives the implicit its sign far from the
+// data, where no local fit is trustworthy.
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "geometry/octree.hpp"
+#include "geometry/point_set.hpp"
+
+namespace gmpu {
+
+class WindingField {
+public:
+    WindingField() = default;
+    // normals: unit outward, 3 per point; area: surface area each point stands for.
+    WindingField(const Octree &tree, const PointSet &points, const std::vector<float> &normals,
+                 const std::vector<float> &area);
+
+    double winding(const Eigen::Vector3d &q) const;
+    bool empty() const { return moments_.empty(); }
+
+private:
+    struct Moment {
+        Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+        Eigen::Vector3d dipole = Eigen::Vector3d::Zero();  // Σ A n
+        double radius = 0.0;                               // of the points about the centroid
+    };
+    double visit(uint32_t cell, const Eigen::Vector3d &q) const;
+    const Octree *tree_ = nullptr;
+    const PointSet *points_ = nullptr;
+    std::vector<Moment> moments_;           // per cell
+    std::vector<Eigen::Vector3f> weighted_;  // per point (in octree order): A n
+};
+
+}  // namespace gmpu

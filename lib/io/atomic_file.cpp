@@ -1,0 +1,104 @@
+#include "io/atomic_file.hpp"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <utility>
+
+#include "io/errors.hpp"
+
+namespace gmpu::io {
+
+namespace {
+
+constexpr size_t buffer_size = size_t{1} << 20;
+
+// Distinguishes temporaries of concurrent writers in one process; the pid distinguishes
+// processes, and O_EXCL catches whatever is left.
+std::atomic<unsigned> temp_counter{0};
+
+}  // namespace
+
+AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
+    // Beside the target (same directory, so same file system: rename() is atomic) and
+    // hidden-ish, so a directory listing during the write shows what is going on.
+    // open(O_EXCL, 0666) rather than mkstemp so the final file gets the usual umask
+    // permissions instead of mkstemp's 0600.
+    for (int attempt = 0; attempt < 100; ++attempt) {
+        char suffix[64];
+        std::snprintf(suffix, sizeof suffix, ".tmp-gmpu-%ld-%u", static_cast<long>(::getpid()),
+                      temp_counter.fetch_add(1));
+        temp_ = path_ + suffix;
+        fd_ = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        if (fd_ >= 0) break;
+        if (errno != EEXIST) {
+            int err = errno;
+            temp_.clear();  // nothing to remove
+            detail::fail(GMPU_ERROR_IO, path_, "cannot create file: " + detail::system_reason(err));
+        }
+    }
+    if (fd_ < 0) {
+        temp_.clear();
+        detail::fail(GMPU_ERROR_IO, path_, "cannot create a temporary file beside it");
+    }
+    buffer_.resize(buffer_size);
+}
+
+AtomicFile::~AtomicFile() {
+    if (fd_ >= 0) ::close(fd_);
+    if (!committed_ && !temp_.empty()) ::unlink(temp_.c_str());
+}
+
+void AtomicFile::fail_io(const char *doing, int err) {
+    // Close and remove now rather than in the destructor, so that the failure is complete
+    // by the time the caller sees the exception.
+    if (fd_ >= 0) ::close(fd_);
+    fd_ = -1;
+    if (!temp_.empty()) ::unlink(temp_.c_str());
+    temp_.clear();
+    detail::fail(GMPU_ERROR_IO, path_, std::string(doing) + ": " + detail::system_reason(err));
+}
+
+void AtomicFile::flush() {
+    size_t done = 0;
+    while (done < used_) {
+        ssize_t n = ::write(fd_, buffer_.data() + done, used_ - done);
+        if (n < 0) {
+            if (errno == EINTR) continue;
+            fail_io("cannot write", errno);
+        }
+        done += static_cast<size_t>(n);
+    }
+    used_ = 0;
+}
+
+void AtomicFile::write(const void *data, size_t size) {
+    if (fd_ < 0) detail::fail(GMPU_ERROR_INTERNAL, path_, "write after failure or commit");
+    const char *bytes = static_cast<const char *>(data);
+    while (size > 0) {
+        if (used_ == buffer_.size()) flush();
+        size_t n = std::min(size, buffer_.size() - used_);
+        std::memcpy(buffer_.data() + used_, bytes, n);
+        used_ += n;
+        bytes += n;
+        size -= n;
+    }
+}
+
+void AtomicFile::commit() {
+    if (fd_ < 0) detail::fail(GMPU_ERROR_INTERNAL, path_, "commit after failure or commit");
+    flush();
+    // close() can report a deferred write error (NFS, quota): check it.
+    int fd = fd_;
+    fd_ = -1;
+    if (::close(fd) != 0) fail_io("cannot write", errno);
+    if (::rename(temp_.c_str(), path_.c_str()) != 0) fail_io("cannot replace", errno);
+    committed_ = true;
+}
+
+}  // namespace gmpu::io

@@ -1,0 +1,33 @@
+// How the io module reports failures: every message starts with the file's path, so a
+// caller juggling several files always knows which one is bad.
+#pragma once
+
+#include <cerrno>
+#include <string>
+#include <string_view>
+#include <system_error>
+
+#include "core/error.hpp"
+
+namespace gmpu::io::detail {
+
+[[noreturn]] inline void fail(gmpu_status status, const std::string &path,
+                              const std::string &what) {
+    throw Error(status, path + ": " + what);
+}
+
+// The system's reason for errno `err` ("No such file or directory"). Thread-safe, unlike
+// strerror().
+inline std::string system_reason(int err) {
+    return std::error_code(err, std::generic_category()).message();
+}
+
+// A token from the file, quoted for a message and cut short: hostile files may hold
+// megabyte-long "numbers".
+inline std::string quoted(std::string_view token) {
+    constexpr size_t max_shown = 40;
+    if (token.size() <= max_shown) return "'" + std::string(token) + "'";
+    return "'" + std::string(token.substr(0, max_shown)) + "...'";
+}
+
+}  // namespace gmpu::io::detail

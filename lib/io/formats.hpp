@@ -1,0 +1,57 @@
+// The per-format readers and writers behind io.hpp. Readers parse an in-memory buffer
+// (`name` is only used in messages), so the fuzz targets in tests/fuzz call them directly
+// and the file readers are a thin read-whole-file wrapper around them.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "io/io.hpp"
+
+namespace gmpu::io {
+
+class AtomicFile;
+
+namespace detail {
+
+// What a reader found. Parsers check structure (counts, indices, truncation, syntax);
+// check_points / check_mesh then check the values (finiteness, emptiness).
+struct Parsed {
+    std::vector<double> positions;   // 3 per vertex
+    std::vector<double> normals;     // 3 per vertex, or empty
+    std::vector<uint32_t> triangles; // 3 per triangle; filled only for Want::mesh
+};
+
+enum class Want { points, mesh };  // mesh: faces are parsed (and checked) too
+
+Parsed parse_ply_buffer(const char *data, size_t size, const std::string &name, Want want);
+Parsed parse_xyz_buffer(const char *data, size_t size, const std::string &name);
+Parsed parse_off_buffer(const char *data, size_t size, const std::string &name, Want want);
+Parsed parse_obj_buffer(const char *data, size_t size, const std::string &name, Want want);
+
+// INVALID_INPUT for a non-finite coordinate or normal (naming the vertex index) and for
+// an empty result ("no points" / "no vertices").
+void check_points(const Parsed &parsed, const std::string &name);
+void check_mesh(const Parsed &parsed, const std::string &name);
+
+// Writers append the whole file to `out`; the caller commits it. `mesh.triangles` is
+// written only by the mesh formats; write_ply writes a face element only when faces is
+// true (point files have none).
+void write_ply(AtomicFile &out, const MeshView &mesh, bool faces);
+void write_obj(AtomicFile &out, const MeshView &mesh);
+void write_off(AtomicFile &out, const MeshView &mesh);
+void write_xyz(AtomicFile &out, const double *xyz, const double *normals, size_t count);
+
+// The polygon of `count` vertex indices (already range-checked) as a triangle fan.
+inline void append_fan(std::vector<uint32_t> &triangles, const uint32_t *polygon, size_t count) {
+    for (size_t k = 1; k + 1 < count; ++k) {
+        triangles.push_back(polygon[0]);
+        triangles.push_back(polygon[k]);
+        triangles.push_back(polygon[k + 1]);
+    }
+}
+
+}  // namespace detail
+}  // namespace gmpu::io

@@ -1,0 +1,35 @@
+// Marching tetrahedra on the Kuhn (Freudenthal) split of each grid cube into six
+// tetrahedra around the 000–111 diagonal. The split is the same in every cube, so
+// neighbouring cubes cut shared faces along the same diagonals, and the isosurface of the
+// piecewise-linear interpolant is a closed 2-manifold wherever the grid's boundary has one
+// sign — which is why the polygonizer uses it instead of marching cubes' ambiguous cases.
+#pragma once
+
+#include <cstdint>
+
+namespace gmpu::mt {
+
+// Corner c of a cube is at offset (c & 1, c >> 1 & 1, c >> 2 & 1).
+constexpr int kTetrahedra = 6;
+extern const uint8_t kTetCorners[kTetrahedra][4];
+
+// An edge between two cube corners, from the lower to the upper one (Kuhn edges always
+// go up in every coordinate): one of 7 directions.
+struct Edge {
+    uint8_t from, to;
+};
+
+// Triangles of one tetrahedron for a sign pattern (bit k set: corner k of the tet is
+// inside, f > 0). Each triangle lists its three vertices as cube edges, wound
+// counter-clockwise seen from outside.
+struct TetCase {
+    uint8_t triangle_count = 0;
+    Edge triangles[2][3];
+};
+const TetCase &tet_case(int tet, int inside_mask);
+
+// Direction index (0..6) of the edge from corner `from` to corner `to`: to − from as the
+// bit pattern xyz, minus one.
+inline int edge_direction(const Edge &e) { return (e.to ^ e.from) - 1; }
+
+}  // namespace gmpu::mt

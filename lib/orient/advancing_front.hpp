@@ -1,0 +1,36 @@
+// Algorithm 1 of the paper: orientation propagated as an advancing front. Each connected
+// component starts from a seed leaf (kept as fitted). The front holds the unlabelled leaves
+// next to labelled ones; the most strongly constrained one is taken first (the paper's
+// FIFO front, ordered by evidence so that ambiguous cells wait for more labelled
+// neighbours). For the active leaf a local graph is grown over unlabelled leaves, with
+// every labelled leaf it touches clamped, belief propagation is run on it, and the active
+// leaf takes its MAP label.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/progress.hpp"
+#include "geometry/octree.hpp"
+#include "orient/leaf_graph.hpp"
+
+namespace gmpu {
+
+struct FrontOptions {
+    int rings = 2;              // hops of unlabelled leaves in each local graph
+    // λ of E_d(ℓ) = −λ ℓ. The paper uses 1, on graphs grown only until they reach one
+    // labelled leaf; on our two-ring graphs, dozens of free leaves would each add a vote
+    // for keeping their arbitrary fitted sign and outweigh the labelled evidence, so the
+    // prior here only breaks ties.
+    double data_weight = 0.01;
+    int bp_iterations = 12;
+};
+
+// Returns ±1 per graph node: +1 keeps the fitted sign, −1 flips it. Labels are consistent
+// within each component; the global sign of a component is decided later (outward.hpp).
+std::vector<int8_t> propagate_orientation(const Octree &tree, const LeafGraph &graph,
+                                          const std::vector<uint32_t> &component,
+                                          uint32_t component_count, const FrontOptions &options,
+                                          Progress &progress);
+
+}  // namespace gmpu

@@ -1,0 +1,118 @@
+#include "orient/orient.hpp"
+
+#include <cmath>
+
+#include "core/parallel.hpp"
+#include "orient/advancing_front.hpp"
+#include "orient/leaf_graph.hpp"
+#include "orient/outward.hpp"
+
+namespace gmpu {
+
+namespace {
+
+// Signs each leaf by its points' normals: ∇f must point inward, against the normals.
+void sign_leaves_by_normals(Octree &tree, const PointSet &points, const float *normals) {
+    std::vector<uint32_t> idx;
+    std::vector<float> d2;
+    Eigen::Vector3d g;
+    for (Cell &c : tree.cells) {
+        if (!c.is_leaf()) continue;
+        idx.assign(tree.order.begin() + c.point_begin, tree.order.begin() + c.point_end);
+        if (idx.empty()) points.nearest(c.centre, 8, idx, d2);  // a leaf holding no point
+        double vote = 0.0;
+        for (uint32_t i : idx) {
+            c.shape.value(points.point(i) - c.centre, tree.pieces, &g);
+            vote += g.dot(Eigen::Vector3d(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]));
+        }
+        c.sign = vote > 0.0 ? -1 : 1;
+        c.oriented = true;
+    }
+}
+
+// Inner cells follow their oriented children: the sign that makes the cell's gradient
+// agree with theirs at the children's points. Children come after parents, so a reverse
+// sweep sees every child oriented before its parent.
+void sign_inner_cells(Octree &tree, const PointSet &points) {
+    constexpr uint32_t kSamplesPerChild = 16;
+    Eigen::Vector3d gp, gc;
+    for (size_t i = tree.cells.size(); i-- > 0;) {
+        Cell &c = tree.cells[i];
+        if (c.is_leaf()) continue;
+        double vote = 0.0;
+        for (int o = 0; o < 8; ++o) {
+            int32_t k = tree.child(c, o);
+            if (k < 0) continue;
+            const Cell &child = tree.cells[size_t(k)];
+            uint32_t n = child.point_end - child.point_begin;
+            uint32_t step = std::max<uint32_t>(1, n / kSamplesPerChild);
+            for (uint32_t j = child.point_begin; j < child.point_end; j += step) {
+                Eigen::Vector3d p = points.point(tree.order[j]);
+                c.shape.value(p - c.centre, tree.pieces, &gp);
+                child.value(p, tree.pieces, &gc);
+                vote += gp.normalized().dot(gc.normalized());
+            }
+        }
+        c.sign = vote < 0.0 ? -1 : 1;
+        c.oriented = true;
+    }
+}
+
+}  // namespace
+
+OrientStats orient_octree(Octree &tree, const PointSet &points, const float *normals,
+                          const Params &params, Progress &progress) {
+    for (Cell &c : tree.cells) c.sign = 1, c.oriented = false;
+    OrientStats stats;
+    const unsigned threads = resolve_threads(params.threads);
+    if (normals) {
+        sign_leaves_by_normals(tree, points, normals);
+        stats.components = 1;
+    } else {
+        LeafGraph graph = build_leaf_graph(tree, threads, progress);
+        progress.report(0.1);
+        std::vector<uint32_t> component = connected_components(graph, stats.components);
+        std::vector<int8_t> label =
+            propagate_orientation(tree, graph, component, stats.components, FrontOptions{}, progress);
+        for (uint32_t v = 0; v < graph.size(); ++v) {
+            Cell &c = tree.cells[graph.cell_of[v]];
+            c.sign = label[v];
+            c.oriented = true;
+        }
+        make_components_outward(tree, points, graph, component, stats.components);
+    }
+    progress.throw_if_cancelled();
+    sign_inner_cells(tree, points);
+    for (const Cell &c : tree.cells) stats.flipped_leaves += c.is_leaf() && c.sign < 0;
+    return stats;
+}
+
+std::vector<float> point_normals(const MpuFunction &f, const PointSet &points, unsigned threads,
+                                 Progress &progress, double done_before, double total) {
+    const Octree &tree = f.tree();
+    std::vector<float> out(3 * points.size());
+    // Walk leaves so each point knows its leaf for the fallback.
+    std::vector<uint32_t> leaves;
+    for (uint32_t i = 0; i < tree.cells.size(); ++i)
+        if (tree.cells[i].is_leaf() && tree.cells[i].point_end > tree.cells[i].point_begin) leaves.push_back(i);
+    parallel_for(0, leaves.size(), threads, progress, [&](size_t l) {
+        const Cell &c = tree.cells[leaves[l]];
+        Eigen::Vector3d g;
+        for (uint32_t k = c.point_begin; k < c.point_end; ++k) {
+            uint32_t i = tree.order[k];
+            Eigen::Vector3d p = points.point(i);
+            f.value(p, &g);
+            double gn = g.norm();
+            if (!(gn > 1e-12) || !g.allFinite()) {
+                c.value(p, tree.pieces, &g);
+                gn = g.norm();
+            }
+            Eigen::Vector3d n = gn > 0.0 ? Eigen::Vector3d(-g / gn) : Eigen::Vector3d::UnitZ();
+            for (int d = 0; d < 3; ++d) out[3 * i + d] = float(n[d]);
+        }
+    }, done_before, total, 8);
+    progress.throw_if_cancelled();
+    return out;
+}
+
+}  // namespace gmpu

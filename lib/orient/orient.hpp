@@ -1,0 +1,34 @@
+// Orient stage: gives every cell's local function its sign, so that the blend is one
+// consistent field, positive inside. Without input normals: leaf graph → belief
+// propagation advanced as a front per component → each component made outward. With
+// input normals: each leaf takes the sign its points' normals vote for. Either way the
+// inner cells (used by the level-of-detail cap and far-field fallback) then follow their
+// oriented children.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "core/params.hpp"
+#include "core/progress.hpp"
+#include "geometry/octree.hpp"
+#include "geometry/point_set.hpp"
+#include "implicit/mpu_function.hpp"
+
+namespace gmpu {
+
+struct OrientStats {
+    uint32_t components = 0;
+    uint32_t flipped_leaves = 0;
+};
+
+// normals: 3 per point (normalised frame directions) or null.
+OrientStats orient_octree(Octree &tree, const PointSet &points, const float *normals,
+                          const Params &params, Progress &progress);
+
+// Unit outward normal at every input point: −∇f/|∇f|, or the oriented fit of the point's
+// leaf where ∇f vanishes. 3 floats per point.
+std::vector<float> point_normals(const MpuFunction &f, const PointSet &points, unsigned threads,
+                                 Progress &progress, double done_before, double total);
+
+}  // namespace gmpu

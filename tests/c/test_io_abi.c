@@ -1,0 +1,309 @@
+/* The point and mesh functions of the C ABI, through the public header only, from C:
+ * argument checks, statuses and messages, round trips through files, and the shared data. */
+#define _GNU_SOURCE /* mkdtemp, nftw */
+#include <stdarg.h>
+#include <stddef.h>
+#include <setjmp.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <dirent.h>
+#include <ftw.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "gmpu/gmpu.h"
+
+static char g_dir[64];
+
+static const char *path_of(const char *name) {
+    static char buf[4][256]; /* a few paths may be alive at once */
+    static int next = 0;
+    char *p = buf[next++ % 4];
+    snprintf(p, 256, "%s/%s", g_dir, name);
+    return p;
+}
+
+static int remove_entry(const char *p, const struct stat *st, int flag, struct FTW *ftw) {
+    (void)st, (void)flag, (void)ftw;
+    return remove(p);
+}
+
+static int setup(void **state) {
+    (void)state;
+    strcpy(g_dir, "/tmp/gmpu_test_io_abi_XXXXXX");
+    return mkdtemp(g_dir) ? 0 : -1;
+}
+
+static int teardown(void **state) {
+    (void)state;
+    return nftw(g_dir, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
+}
+
+static int count_entries(const char *dir) {
+    int n = 0;
+    DIR *d = opendir(dir);
+    struct dirent *e;
+    if (!d) return -1;
+    while ((e = readdir(d)) != NULL)
+        if (strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0) ++n;
+    closedir(d);
+    return n;
+}
+
+static void put(const char *path, const char *text) {
+    FILE *f = fopen(path, "wb");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+}
+
+/* The status must be `expected` and gmpu_last_error() must name it and contain `needle`. */
+static void check_failure(gmpu_status got, gmpu_status expected, const char *needle) {
+    const char *msg = gmpu_last_error();
+    if (got != expected)
+        fail_msg("expected %s, got %s (%s)", gmpu_status_name(expected), gmpu_status_name(got), msg);
+    if (strstr(msg, gmpu_status_name(expected)) == NULL || strstr(msg, needle) == NULL)
+        fail_msg("message \"%s\" lacks \"%s\" or \"%s\"", msg, gmpu_status_name(expected), needle);
+}
+
+static const double tet[12] = {0.1, -0.0, 1e-300, 1, 2.5, 1.0 / 3.0, -7, 6.02214076e23, 0, 4, 5, 6};
+static const uint32_t tet_faces[12] = {0, 1, 2, 0, 3, 1, 1, 3, 2, 2, 3, 0};
+
+static void test_points_create_and_access(void **state) {
+    (void)state;
+    const double n[12] = {0, 0, 1, 0, 1, 0, 1, 0, 0, 0, 0, -1};
+    gmpu_points *p = NULL;
+    assert_int_equal(gmpu_points_create(tet, n, 4, &p), GMPU_OK);
+    assert_int_equal(gmpu_points_count(p), 4);
+    assert_memory_equal(gmpu_points_positions(p), tet, sizeof tet);
+    assert_memory_equal(gmpu_points_normals(p), n, sizeof n);
+    gmpu_points_destroy(p);
+
+    assert_int_equal(gmpu_points_create(tet, NULL, 4, &p), GMPU_OK);
+    assert_null(gmpu_points_normals(p));
+    gmpu_points_destroy(p);
+
+    /* NULL handles are harmless. */
+    gmpu_points_destroy(NULL);
+    assert_int_equal(gmpu_points_count(NULL), 0);
+    assert_null(gmpu_points_positions(NULL));
+    assert_null(gmpu_points_normals(NULL));
+}
+
+static void test_points_create_errors(void **state) {
+    (void)state;
+    gmpu_points *p = (gmpu_points *)&p; /* garbage that must become NULL */
+    check_failure(gmpu_points_create(NULL, NULL, 3, &p), GMPU_ERROR_INVALID_ARGUMENT, "xyz is NULL");
+    assert_null(p);
+    check_failure(gmpu_points_create(tet, NULL, 4, NULL), GMPU_ERROR_INVALID_ARGUMENT, "out is NULL");
+    p = (gmpu_points *)&p;
+    check_failure(gmpu_points_create(tet, NULL, 0, &p), GMPU_ERROR_INVALID_INPUT, "no points");
+    assert_null(p);
+    check_failure(gmpu_points_create(tet, NULL, SIZE_MAX / 2, &p), GMPU_ERROR_INVALID_ARGUMENT, "too large");
+
+    double bad[6] = {0, 0, 0, 1, 2, NAN};
+    p = (gmpu_points *)&p;
+    check_failure(gmpu_points_create(bad, NULL, 2, &p), GMPU_ERROR_INVALID_INPUT, "point 1");
+    assert_null(p);
+    double badn[6] = {0, 0, 1, INFINITY, 0, 0};
+    check_failure(gmpu_points_create(tet, badn, 2, &p), GMPU_ERROR_INVALID_INPUT, "normal of point 1");
+    assert_null(p);
+}
+
+static void test_points_file_round_trip(void **state) {
+    (void)state;
+    const double n[12] = {0, 0, 1, 0, 1, 0, 1, 0, 0, 0.6, 0.8, 0};
+    const char *names[] = {"p.ply", "p.xyz", "P.XYZ"};
+    for (int i = 0; i < 3; ++i) {
+        for (int with_normals = 0; with_normals < 2; ++with_normals) {
+            gmpu_points *p = NULL, *q = NULL;
+            assert_int_equal(gmpu_points_create(tet, with_normals ? n : NULL, 4, &p), GMPU_OK);
+            const char *path = path_of(names[i]);
+            assert_int_equal(gmpu_points_write(p, path), GMPU_OK);
+            assert_int_equal(gmpu_points_read(path, &q), GMPU_OK);
+            assert_int_equal(gmpu_points_count(q), 4);
+            assert_memory_equal(gmpu_points_positions(q), tet, sizeof tet); /* bit-exact */
+            if (with_normals)
+                assert_memory_equal(gmpu_points_normals(q), n, sizeof n);
+            else
+                assert_null(gmpu_points_normals(q));
+            gmpu_points_destroy(p);
+            gmpu_points_destroy(q);
+        }
+    }
+}
+
+static void test_points_read_errors(void **state) {
+    (void)state;
+    gmpu_points *p = (gmpu_points *)&p;
+    check_failure(gmpu_points_read(NULL, &p), GMPU_ERROR_INVALID_ARGUMENT, "path is NULL");
+    assert_null(p);
+    check_failure(gmpu_points_read(path_of("x.ply"), NULL), GMPU_ERROR_INVALID_ARGUMENT, "out is NULL");
+
+    const char *missing = path_of("missing.ply");
+    p = (gmpu_points *)&p;
+    check_failure(gmpu_points_read(missing, &p), GMPU_ERROR_IO, missing);
+    assert_null(p);
+    check_failure(gmpu_points_read(missing, &p), GMPU_ERROR_IO, "No such file or directory");
+    check_failure(gmpu_points_read(g_dir, &p), GMPU_ERROR_UNSUPPORTED, "no file extension");
+    check_failure(gmpu_points_read(path_of("a.stl"), &p), GMPU_ERROR_UNSUPPORTED, "'.stl'");
+
+    const char *bad = path_of("bad.xyz");
+    put(bad, "1 2 3\n4 5 six\n");
+    check_failure(gmpu_points_read(bad, &p), GMPU_ERROR_PARSE, "line 2: invalid number 'six'");
+    assert_null(p);
+    put(bad, "1 2 3\n4 5 nan\n");
+    check_failure(gmpu_points_read(bad, &p), GMPU_ERROR_INVALID_INPUT, "vertex 1");
+    put(bad, "# nothing\n");
+    check_failure(gmpu_points_read(bad, &p), GMPU_ERROR_INVALID_INPUT, "no points");
+    const char *ply = path_of("bad.ply");
+    put(ply, "ply\nformat ascii 1.0\nelement vertex 9\nproperty float x\nproperty float y\n"
+             "property float z\nend_header\n1 2 3\n");
+    check_failure(gmpu_points_read(ply, &p), GMPU_ERROR_PARSE, "expected 9 vertices, file ends after 1");
+    put(ply, "ply\nformat binary_middle_endian 1.0\nend_header\n");
+    check_failure(gmpu_points_read(ply, &p), GMPU_ERROR_UNSUPPORTED, "binary_middle_endian");
+    assert_null(p);
+}
+
+static void test_points_write_errors(void **state) {
+    (void)state;
+    gmpu_points *p = NULL;
+    assert_int_equal(gmpu_points_create(tet, NULL, 4, &p), GMPU_OK);
+    check_failure(gmpu_points_write(NULL, path_of("a.ply")), GMPU_ERROR_INVALID_ARGUMENT, "points is NULL");
+    check_failure(gmpu_points_write(p, NULL), GMPU_ERROR_INVALID_ARGUMENT, "path is NULL");
+    check_failure(gmpu_points_write(p, path_of("a.off")), GMPU_ERROR_UNSUPPORTED, "'.off'");
+    const char *deep = path_of("no/such/dir/a.ply");
+    check_failure(gmpu_points_write(p, deep), GMPU_ERROR_IO, deep);
+    check_failure(gmpu_points_write(p, deep), GMPU_ERROR_IO, "No such file or directory");
+    gmpu_points_destroy(p);
+    assert_int_equal(count_entries(g_dir), 0); /* nothing created, not even a temporary */
+}
+
+static void test_mesh_create_and_access(void **state) {
+    (void)state;
+    gmpu_mesh *m = NULL;
+    assert_int_equal(gmpu_mesh_create(tet, 4, tet_faces, 4, &m), GMPU_OK);
+    assert_int_equal(gmpu_mesh_vertex_count(m), 4);
+    assert_int_equal(gmpu_mesh_triangle_count(m), 4);
+    assert_memory_equal(gmpu_mesh_vertices(m), tet, sizeof tet);
+    assert_memory_equal(gmpu_mesh_triangles(m), tet_faces, sizeof tet_faces);
+    assert_null(gmpu_mesh_normals(m)); /* made by gmpu_mesh_create */
+    gmpu_mesh_destroy(m);
+
+    /* An empty mesh is a valid mesh. */
+    assert_int_equal(gmpu_mesh_create(NULL, 0, NULL, 0, &m), GMPU_OK);
+    assert_int_equal(gmpu_mesh_vertex_count(m), 0);
+    assert_int_equal(gmpu_mesh_triangle_count(m), 0);
+    gmpu_mesh_destroy(m);
+
+    gmpu_mesh_destroy(NULL);
+    assert_int_equal(gmpu_mesh_vertex_count(NULL), 0);
+    assert_int_equal(gmpu_mesh_triangle_count(NULL), 0);
+    assert_null(gmpu_mesh_vertices(NULL));
+    assert_null(gmpu_mesh_normals(NULL));
+    assert_null(gmpu_mesh_triangles(NULL));
+}
+
+static void test_mesh_create_errors(void **state) {
+    (void)state;
+    gmpu_mesh *m = (gmpu_mesh *)&m;
+    check_failure(gmpu_mesh_create(NULL, 4, tet_faces, 4, &m), GMPU_ERROR_INVALID_ARGUMENT, "vertices is NULL");
+    assert_null(m);
+    m = (gmpu_mesh *)&m;
+    check_failure(gmpu_mesh_create(tet, 4, NULL, 4, &m), GMPU_ERROR_INVALID_ARGUMENT, "triangles is NULL");
+    assert_null(m);
+    check_failure(gmpu_mesh_create(tet, 4, tet_faces, 4, NULL), GMPU_ERROR_INVALID_ARGUMENT, "out is NULL");
+    const uint32_t bad_faces[6] = {0, 1, 2, 0, 1, 4};
+    m = (gmpu_mesh *)&m;
+    check_failure(gmpu_mesh_create(tet, 4, bad_faces, 2, &m), GMPU_ERROR_INVALID_INPUT,
+                  "triangle 1 uses vertex index 4, but vertex_count is 4");
+    assert_null(m);
+    double nan_v[9] = {0, 0, 0, 1, 0, 0, 0, INFINITY, 0};
+    check_failure(gmpu_mesh_create(nan_v, 3, tet_faces, 1, &m), GMPU_ERROR_INVALID_INPUT, "vertex 2");
+    assert_null(m);
+}
+
+static void test_mesh_write(void **state) {
+    (void)state;
+    gmpu_mesh *m = NULL;
+    assert_int_equal(gmpu_mesh_create(tet, 4, tet_faces, 4, &m), GMPU_OK);
+    const char *names[] = {"m.ply", "m.obj", "m.off", "M.OFF"};
+    const char *magic[] = {"ply\nformat binary_little_endian 1.0\n", "# written by gmpu\nv ", "OFF\n4 4 0\n", "OFF\n"};
+    for (int i = 0; i < 4; ++i) {
+        const char *path = path_of(names[i]);
+        assert_int_equal(gmpu_mesh_write(m, path), GMPU_OK);
+        char head[64] = {0};
+        FILE *f = fopen(path, "rb");
+        assert_non_null(f);
+        assert_true(fread(head, 1, strlen(magic[i]), f) == strlen(magic[i]));
+        fclose(f);
+        assert_string_equal(head, magic[i]);
+        /* The vertices read back bit-exact, whatever the format. */
+        gmpu_points *p = NULL;
+        assert_int_equal(gmpu_points_read(path, &p), GMPU_OK);
+        assert_int_equal(gmpu_points_count(p), 4);
+        assert_memory_equal(gmpu_points_positions(p), tet, sizeof tet);
+        gmpu_points_destroy(p);
+    }
+
+    mkdir(path_of("w"), 0755);
+    check_failure(gmpu_mesh_write(NULL, path_of("w/a.ply")), GMPU_ERROR_INVALID_ARGUMENT, "mesh is NULL");
+    check_failure(gmpu_mesh_write(m, NULL), GMPU_ERROR_INVALID_ARGUMENT, "path is NULL");
+    check_failure(gmpu_mesh_write(m, path_of("w/a.stl")), GMPU_ERROR_UNSUPPORTED, "'.stl'");
+    check_failure(gmpu_mesh_write(m, path_of("w/a.xyz")), GMPU_ERROR_UNSUPPORTED, "'.xyz'");
+    const char *deep = path_of("w/missing/a.obj");
+    check_failure(gmpu_mesh_write(m, deep), GMPU_ERROR_IO, deep);
+    check_failure(gmpu_mesh_write(m, deep), GMPU_ERROR_IO, "No such file or directory");
+    mkdir(path_of("w/dir.ply"), 0755);
+    check_failure(gmpu_mesh_write(m, path_of("w/dir.ply")), GMPU_ERROR_IO, "Is a directory");
+    assert_int_equal(count_entries(path_of("w")), 1); /* only dir.ply: no temporaries */
+    assert_int_equal(count_entries(path_of("w/dir.ply")), 0);
+    gmpu_mesh_destroy(m);
+}
+
+static void test_shared_data(void **state) {
+    (void)state;
+    const char *root = getenv("GMPU_SHARED_DATA");
+    char path[512];
+    gmpu_points *p = NULL;
+    snprintf(path, sizeof path, "%s/clouds/bunny_clean.ply", root ? root : "../shared/data");
+    assert_int_equal(gmpu_points_read(path, &p), GMPU_OK);
+    assert_int_equal(gmpu_points_count(p), 35000);
+    assert_null(gmpu_points_normals(p));
+    gmpu_points_destroy(p);
+    snprintf(path, sizeof path, "%s/clouds/bunny_clean_gt.ply", root ? root : "../shared/data");
+    assert_int_equal(gmpu_points_read(path, &p), GMPU_OK);
+    assert_int_equal(gmpu_points_count(p), 35000);
+    const double *n = gmpu_points_normals(p);
+    assert_non_null(n);
+    assert_true(fabs(n[0] * n[0] + n[1] * n[1] + n[2] * n[2] - 1) < 1e-4);
+    gmpu_points_destroy(p);
+    snprintf(path, sizeof path, "%s/scans/kitten.xyz", root ? root : "../shared/data");
+    assert_int_equal(gmpu_points_read(path, &p), GMPU_OK);
+    assert_int_equal(gmpu_points_count(p), 5210);
+    assert_non_null(gmpu_points_normals(p));
+    gmpu_points_destroy(p);
+    snprintf(path, sizeof path, "%s/meshes/bunny00.off", root ? root : "../shared/data");
+    assert_int_equal(gmpu_points_read(path, &p), GMPU_OK);
+    assert_int_equal(gmpu_points_count(p), 37706);
+    gmpu_points_destroy(p);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_points_create_and_access),
+        cmocka_unit_test(test_points_create_errors),
+        cmocka_unit_test(test_points_write_errors), /* first to touch g_dir: counts entries */
+        cmocka_unit_test(test_points_file_round_trip),
+        cmocka_unit_test(test_points_read_errors),
+        cmocka_unit_test(test_mesh_create_and_access),
+        cmocka_unit_test(test_mesh_create_errors),
+        cmocka_unit_test(test_mesh_write),
+        cmocka_unit_test(test_shared_data),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
