@@ -64,8 +64,11 @@ test-rust: build
 test-sanitize: deps-test
 
 bench: deps-bench build
+	$(PYTHON) tests/bench/run_bench.py --build $(BUILD) --out bench-results
+	$(PYTHON) tests/bench/update_readme.py bench-results
 
 bench-quick: deps-bench build
+	$(PYTHON) tests/bench/run_bench.py --quick --build $(BUILD) --out bench-results/quick
 
 fuzz: deps-test
 

@@ -211,6 +211,9 @@ int main(int argc, char **argv) {
 
     if (!o.quiet) {
         double cells = 0, leaves = 0, depth = 0, comps = 0, fit = 0, orient = 0, poly = 0, res = 0;
+        double noise = 0, eps = 0;
+        gmpu_surface_get_stat(surface, GMPU_STAT_NOISE, &noise);
+        gmpu_surface_get_stat(surface, GMPU_STAT_EFFECTIVE_ERROR, &eps);
         gmpu_surface_get_stat(surface, GMPU_STAT_CELLS, &cells);
         gmpu_surface_get_stat(surface, GMPU_STAT_LEAVES, &leaves);
         gmpu_surface_get_stat(surface, GMPU_STAT_DEPTH, &depth);
@@ -221,10 +224,12 @@ int main(int argc, char **argv) {
         gmpu_surface_get_stat(surface, GMPU_STAT_RESOLUTION, &res);
         fprintf(stderr,
                 "gmpu: %zu points, %.0f cells (%.0f leaves, depth %.0f), %.0f component%s\n"
+                "gmpu: estimated noise %.3f%% of the diagonal, fitted to error %.3f%%\n"
                 "gmpu: mesh %zu vertices, %zu triangles at resolution %.0f -> %s\n"
                 "gmpu: time read %.3f s, fit %.3f s, orient %.3f s, polygonize %.3f s, write %.3f s, "
                 "total %.3f s\n",
-                n, cells, leaves, depth, comps, comps == 1 ? "" : "s", gmpu_mesh_vertex_count(mesh),
+                n, cells, leaves, depth, comps, comps == 1 ? "" : "s", 100 * noise, 100 * eps,
+                gmpu_mesh_vertex_count(mesh),
                 gmpu_mesh_triangle_count(mesh), res, o.output, t_read - t_start, fit, orient, poly,
                 t_end - t_write, t_end - t_start);
     }

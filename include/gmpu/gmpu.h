@@ -127,7 +127,11 @@ typedef enum gmpu_param {
     GMPU_PARAM_MAX_CELLS = 9,
     /* Resource cap: polygonize fails with GMPU_ERROR_LIMIT_EXCEEDED instead of making
      * more triangles than this. Default 100,000,000. Range 1..2e9. */
-    GMPU_PARAM_MAX_TRIANGLES = 10
+    GMPU_PARAM_MAX_TRIANGLES = 10,
+    /* Noise floor for ε: fit estimates the sampling noise σ̂ and works to
+     * max(GMPU_PARAM_ERROR, NOISE_SCALE × σ̂), since fitting below the noise only fits the
+     * noise. Default 3; 0 turns the floor off. Range [0, 20]. Discards a previous fit. */
+    GMPU_PARAM_NOISE_SCALE = 11
 } gmpu_param;
 
 typedef enum gmpu_stage {
@@ -150,7 +154,9 @@ typedef enum gmpu_stat {
     GMPU_STAT_ORIENT_SECONDS = 11,
     GMPU_STAT_POLYGONIZE_SECONDS = 12,
     GMPU_STAT_RESOLUTION = 13,        /* grid resolution the last polygonize used */
-    GMPU_STAT_BBOX_DIAGONAL = 14      /* diagonal of the points' bounding box */
+    GMPU_STAT_BBOX_DIAGONAL = 14,     /* diagonal of the points' bounding box */
+    GMPU_STAT_NOISE = 15,             /* estimated noise σ̂, as a fraction of the diagonal */
+    GMPU_STAT_EFFECTIVE_ERROR = 16    /* the ε fit worked to, as a fraction of the diagonal */
 } gmpu_stat;
 
 /* Progress and cancellation. Called on the thread that called fit / orient / polygonize,
@@ -223,7 +229,8 @@ GMPU_API size_t gmpu_surface_point_count(const gmpu_surface *surface);
 /* Builds the adaptive octree and a local shape function per cell (paper §3): surface
  * variation σ > 0.25 → general quadric (Taubin fit), else bivariate quadratic in the PCA
  * frame, piecewise quadrics at sharp features; cells are subdivided until the Taubin
- * error is below GMPU_PARAM_ERROR. Discards a previous orientation.
+ * error is below ε = max(GMPU_PARAM_ERROR, GMPU_PARAM_NOISE_SCALE × estimated noise).
+ * Discards a previous orientation.
  * Errors: WRONG_ORDER (no points), LIMIT_EXCEEDED (GMPU_PARAM_MAX_CELLS), CANCELLED,
  * OUT_OF_MEMORY. Cost: about O(n log n); 35k points take ~0.1 s on 2 cores. */
 GMPU_API gmpu_status gmpu_surface_fit(gmpu_surface *surface);

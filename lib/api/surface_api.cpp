@@ -13,6 +13,7 @@
 #include "core/params.hpp"
 #include "core/progress.hpp"
 #include "fit/build_octree.hpp"
+#include "fit/noise_estimate.hpp"
 #include "geometry/point_set.hpp"
 #include "implicit/mpu_function.hpp"
 #include "implicit/surface_field.hpp"
@@ -39,6 +40,7 @@ struct gmpu_surface {
     gmpu::OrientStats orient_stats;
     double seconds[4] = {0, 0, 0, 0};  // by gmpu_stage
     int last_resolution = 0;
+    double noise = 0.0, epsilon = 0.0;  // of the last fit, normalised units
 
     void discard_fit() {
         if (stage > Stage::points) stage = Stage::points;
@@ -77,6 +79,7 @@ ParamSpec spec(gmpu_param key) {
         case GMPU_PARAM_THREADS: return {0, 1024, true, false, "GMPU_PARAM_THREADS"};
         case GMPU_PARAM_MAX_CELLS: return {1, 1e9, true, true, "GMPU_PARAM_MAX_CELLS"};
         case GMPU_PARAM_MAX_TRIANGLES: return {1, 2e9, true, false, "GMPU_PARAM_MAX_TRIANGLES"};
+        case GMPU_PARAM_NOISE_SCALE: return {0, 20, false, true, "GMPU_PARAM_NOISE_SCALE"};
     }
     throw Error(GMPU_ERROR_INVALID_ARGUMENT, "unknown parameter key " + std::to_string(int(key)));
 }
@@ -87,6 +90,7 @@ double *param_slot(gmpu::Params &p, gmpu_param key, double &scratch) {
         case GMPU_PARAM_SUPPORT_SCALE: return &p.support_scale;
         case GMPU_PARAM_MAX_CELLS: return &p.max_cells;
         case GMPU_PARAM_MAX_TRIANGLES: return &p.max_triangles;
+        case GMPU_PARAM_NOISE_SCALE: return &p.noise_scale;
         default: return &scratch;  // integer-valued: converted by the caller
     }
 }
@@ -103,6 +107,7 @@ double get_param(const gmpu::Params &p, gmpu_param key) {
         case GMPU_PARAM_THREADS: return p.threads;
         case GMPU_PARAM_MAX_CELLS: return p.max_cells;
         case GMPU_PARAM_MAX_TRIANGLES: return p.max_triangles;
+        case GMPU_PARAM_NOISE_SCALE: return p.noise_scale;
     }
     throw Error(GMPU_ERROR_INVALID_ARGUMENT, "unknown parameter key " + std::to_string(int(key)));
 }
@@ -252,6 +257,14 @@ GMPU_API gmpu_status gmpu_surface_get_stat(const gmpu_surface *s, gmpu_stat key,
             case GMPU_STAT_POLYGONIZE_SECONDS: *value = s->seconds[GMPU_STAGE_POLYGONIZE]; break;
             case GMPU_STAT_RESOLUTION: *value = s->last_resolution; break;
             case GMPU_STAT_BBOX_DIAGONAL: *value = s->points.empty() ? 0.0 : s->points.world_diagonal(); break;
+            case GMPU_STAT_NOISE:
+            case GMPU_STAT_EFFECTIVE_ERROR: {
+                // Normalised units → fraction of the diagonal.
+                double diag = s->points.empty() ? 0.0 : s->points.world_diagonal() * s->points.normalisation().scale;
+                double v = key == GMPU_STAT_NOISE ? s->noise : s->epsilon;
+                *value = diag > 0.0 && s->stage >= gmpu_surface::Stage::fitted ? v / diag : 0.0;
+                break;
+            }
             default: throw Error(GMPU_ERROR_INVALID_ARGUMENT, "unknown statistic key " + std::to_string(int(key)));
         }
     });
@@ -287,9 +300,13 @@ GMPU_API gmpu_status gmpu_surface_fit(gmpu_surface *s) {
         auto t0 = Clock::now();
         gmpu::Progress progress(s->progress_fn, s->progress_user, GMPU_STAGE_FIT);
         progress.report(0.0, true);
-        gmpu::Octree tree = gmpu::build_octree(s->points, s->params, progress);
+        const double noise = gmpu::estimate_noise(s->points);
+        const double epsilon = gmpu::effective_epsilon(s->points, s->params, noise);
+        gmpu::Octree tree = gmpu::build_octree(s->points, s->params, epsilon, progress);
         s->discard_fit();
         s->tree = std::move(tree);
+        s->noise = noise;
+        s->epsilon = epsilon;
         s->stage = gmpu_surface::Stage::fitted;
         s->seconds[GMPU_STAGE_FIT] = since(t0);
     });

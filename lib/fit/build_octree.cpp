@@ -21,7 +21,8 @@ struct Builder {
     double support_radius(double size) const { return params.support_scale * std::sqrt(3.0) * size; }
 
     bool should_subdivide(const Cell &c) const {
-        return c.error > epsilon && c.depth < params.max_depth;
+        return c.error > epsilon && c.depth < params.max_depth &&
+               c.initial_count >= uint32_t(params.min_points);
     }
 
     // Gathers the support and fits it; returns false when the ball holds no point and the
@@ -175,8 +176,13 @@ struct Builder {
 
 }  // namespace
 
-Octree build_octree(const PointSet &points, const Params &params, Progress &progress) {
-    Builder b{points, params, params.error * points.world_diagonal() * points.normalisation().scale, {}};
+double effective_epsilon(const PointSet &points, const Params &params, double noise) {
+    const double requested = params.error * points.world_diagonal() * points.normalisation().scale;
+    return std::max(requested, params.noise_scale * noise);
+}
+
+Octree build_octree(const PointSet &points, const Params &params, double epsilon, Progress &progress) {
+    Builder b{points, params, epsilon, {}};
     return b.run(progress);
 }
 

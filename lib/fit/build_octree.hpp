@@ -14,7 +14,11 @@
 
 namespace gmpu {
 
-// Throws CANCELLED or LIMIT_EXCEEDED (GMPU_PARAM_MAX_CELLS).
-Octree build_octree(const PointSet &points, const Params &params, Progress &progress);
+// The ε the fit works to, in normalised units: the caller's, raised to noise_scale × the
+// estimated noise (noise_estimate.hpp).
+double effective_epsilon(const PointSet &points, const Params &params, double noise);
+
+// Throws CANCELLED or LIMIT_EXCEEDED (GMPU_PARAM_MAX_CELLS). epsilon in normalised units.
+Octree build_octree(const PointSet &points, const Params &params, double epsilon, Progress &progress);
 
 }  // namespace gmpu

@@ -34,7 +34,8 @@ Quadric fit_bivariate(const PointList &points, const Pca &pca, double scale);
 // eigenproblem), then normalised to unit mean gradient on the points.
 Quadric fit_general_quadric(const PointList &points, double scale);
 
-// Taubin's distance error max_p |Q(p)| / |∇Q(p)| over the points.
+// Robust Taubin distance error over the points, from d_p = |Q(p)| / |∇Q(p)|:
+// max(90th percentile of d_p, max_p d_p / 3). See taubin_error.cpp for why not the max.
 double taubin_error(const LocalShape &shape, const std::vector<PiecewiseShape> &pieces,
                     const PointList &points);
 

@@ -5,8 +5,9 @@
 // space they cross zero in spurious sheets (a known MPU pitfall). So a query x is
 // "trusted" when it lies within the trust radius of its nearest input point (a few local
 // spacings, never less than two polygonizer cubes); there f is the MPU blend. Farther out
-// f = ±d(x), the distance to the nearest point p, signed by which side of p's oriented
-// normal x lies on (Hoppe's test, reliable once x is a few spacings away): continuous
+// f = ±d(x), the distance to the nearest point, signed by which side of the nearby points'
+// oriented normals x lies on (Hoppe's test, voted over the 8 nearest points; reliable once
+// x is a few spacings away): continuous
 // enough at the border (the blend is about a signed distance too) and never zero, so no
 // surface can appear away from the data.
 #pragma once
@@ -39,7 +40,7 @@ public:
     // Distance to the nearest point and whether x is trusted; `nearest` receives its index.
     bool trusted(const Eigen::Vector3d &x, double min_trust, double &distance, uint32_t &nearest) const;
 
-    // The far-field value at an untrusted x: ±distance, signed by the nearest normal.
+    // The far-field value at an untrusted x: ±distance, signed by the nearest normals.
     double far_value(const Eigen::Vector3d &x, double distance, uint32_t nearest, Eigen::Vector3d *gradient) const;
 
     const MpuFunction &mpu() const { return mpu_; }

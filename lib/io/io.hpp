@@ -34,6 +34,16 @@ struct MeshView {
 
 // .ply (ascii, binary_little_endian, binary_big_endian), .xyz/.txt (3 or 6 columns),
 // .off, .obj (vertices only). Format chosen by extension, case-insensitive.
+//
+// Which failure is which (every message starts with the path):
+//   IO            the file is missing, unreadable or a directory (with the system's reason);
+//   UNSUPPORTED   the extension, a PLY format/version/property type, 4OFF/nOFF, binary OFF;
+//   PARSE         bad syntax, a token that is not entirely a number ("1.0abc") or is beyond
+//                 the double range ("1e999"), a header count the file does not hold
+//                 ("expected N vertices, file ends after M"), a face index out of range;
+//   INVALID_INPUT no points, or a NaN / infinite coordinate or normal (binary, or "nan" /
+//                 "inf" in text), naming the vertex index.
+// Per format: lib/io/ply_reader.cpp, xyz_format.cpp, off_format.cpp, obj_format.cpp.
 PointCloud read_points(const std::string &path);
 
 // Vertices and faces of .off, .obj or .ply meshes (used by tests and the benchmark).

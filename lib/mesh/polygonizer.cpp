@@ -29,10 +29,11 @@ struct Grid {
     int64_t block_id(int64_t x, int64_t y, int64_t z) const { return x + blocks[0] * (y + blocks[1] * z); }
 };
 
-Grid make_grid(const PointSet &points, int resolution) {
+// `dilation`: how many blocks the band reaches beyond the blocks holding points.
+Grid make_grid(const PointSet &points, int resolution, int dilation) {
     Grid g;
     g.h = 1.0 / resolution;  // the longest side of the normalised box is 1
-    const double pad = 2.0 * B * g.h;  // keeps the band two blocks off the grid's edge
+    const double pad = (dilation + 1) * B * g.h;  // keeps the band a block off the grid's edge
     g.origin = points.box_min() - Eigen::Vector3d::Constant(pad);
     for (int d = 0; d < 3; ++d) {
         double extent = points.box_max()[d] - points.box_min()[d] + 2.0 * pad;
@@ -210,12 +211,13 @@ int default_resolution(const Octree &tree, const PointSet &points) {
 
 Mesh polygonize(const SurfaceField &f, const WindingField &winding, const PointSet &points,
                 const PointMeasures &measures, int resolution, const Params &params, Progress &progress) {
-    const Grid g = make_grid(points, resolution);
     // The band must hold every trusted corner, so it reaches past the widest trust radius
     // (its 99th percentile: one isolated outlier must not widen it everywhere).
     std::vector<float> trust(measures.trust_radius);
     std::nth_element(trust.begin(), trust.begin() + long(trust.size() * 99 / 100), trust.end());
-    const int dilation = std::clamp(1 + int(double(trust[trust.size() * 99 / 100]) / (g.h * B)), 1, 3);
+    const double h = 1.0 / resolution;
+    const int dilation = std::clamp(1 + int(double(trust[trust.size() * 99 / 100]) / (h * B)), 1, 3);
+    const Grid g = make_grid(points, resolution, dilation);
     const Regions r = find_regions(g, points, winding, dilation);
     std::vector<int64_t> band;
     for (int64_t b = 0; b < int64_t(r.band.size()); ++b)

@@ -436,7 +436,7 @@ void sampling_is_area_uniform_and_reproducible(void **) {
         on_x_faces += std::abs(a.normals[i].x()) == 1;
     }
     // x faces: 2 × (2·1)(2·1) = 8 of the total area 40.
-    assert_near(on_x_faces / 1e5, 0.2, 0.006);  // ~5 standard deviations
+    assert_near(double(on_x_faces) / 1e5, 0.2, 0.006);  // ~5 standard deviations
 }
 
 void sampling_is_uniform_inside_a_triangle(void **) {
@@ -446,7 +446,7 @@ void sampling_is_uniform_inside_a_triangle(void **) {
     tri.triangles = {{0, 1, 2}};
     size_t corner = 0;
     for (const Vec3 &p : sample_mesh(tri, 40000, 5).positions) corner += p.x() + p.y() < 0.5;
-    assert_near(corner / 4e4, 0.25, 0.011);  // ~5 standard deviations
+    assert_near(double(corner) / 4e4, 0.25, 0.011);  // ~5 standard deviations
 }
 
 void nonuniform_density_grows_tenfold(void **) {
@@ -523,12 +523,12 @@ void analytic_sampling_is_area_uniform(void **) {
     const OrientedPoints t = torus.sample(50000, 4);
     size_t outer = 0;
     for (const Vec3 &p : t.positions) outer += std::hypot(p.x(), p.y()) > R;
-    assert_near(outer / 5e4, (kPi * R + 2 * r) / (2 * kPi * R), 0.01);
+    assert_near(double(outer) / 5e4, (kPi * R + 2 * r) / (2 * kPi * R), 0.01);
     // On a shell the inner sphere gets r² / (R² + r²) of the points.
     const OrientedPoints s = NestedSpheres(Vec3::Zero(), 0.5, 1).sample(50000, 4);
     size_t inner = 0;
     for (const Vec3 &p : s.positions) inner += p.norm() < 0.75;
-    assert_near(inner / 5e4, 0.25 / 1.25, 0.01);
+    assert_near(double(inner) / 5e4, 0.25 / 1.25, 0.01);
     // Areas agree with fine meshes of the same solids.
     assert_near(surface_area(torus_mesh(R, r, 400, 120)), torus.area(), 1e-3 * torus.area());
     assert_near(surface_area(icosphere(5)), Sphere(Vec3::Zero(), 1).area(), 2e-3 * 4 * kPi);

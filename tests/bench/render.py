@@ -1,0 +1,116 @@
+"""Side-by-side pictures of reconstructions, drawn the same way for every pipeline.
+
+A small point-splatting renderer in numpy (no GPU, no display): each mesh is sampled
+area-uniformly, the samples are projected orthographically, and per pixel the nearest
+sample wins. A sample keeps the normal of its triangle *as wound*, so a surface seen from
+its back — inside-out — is painted red, and a missing part shows the white background.
+"""
+import numpy as np
+
+FRONT = np.array([0.72, 0.80, 0.92])  # outward side facing the camera
+BACK = np.array([0.93, 0.28, 0.22])   # inward side facing the camera: inside-out
+BACKGROUND = 1.0
+
+
+def read_mesh(path):
+    """(vertices n×3, triangles m×3) of a .ply / .off / .obj, through Open3D's reader."""
+    import open3d as o3d
+
+    mesh = o3d.io.read_triangle_mesh(str(path))
+    return np.asarray(mesh.vertices, dtype=np.float64), np.asarray(mesh.triangles, dtype=np.int64)
+
+
+def camera(azimuth_deg, elevation_deg):
+    """Rotation world → camera (x right, y up, z toward the viewer), world +y up."""
+    a, e = np.radians(azimuth_deg), np.radians(elevation_deg)
+    toward_viewer = np.array([np.sin(a) * np.cos(e), np.sin(e), np.cos(a) * np.cos(e)])
+    right = np.cross([0.0, 1.0, 0.0], toward_viewer)
+    right /= np.linalg.norm(right)
+    up = np.cross(toward_viewer, right)
+    return np.stack([right, up, toward_viewer])
+
+
+def render(vertices, triangles, rotation, center, half_extent, size=420, seed=0):
+    """An RGB image (size×size×3, floats in [0, 1]) of the mesh; center and half_extent (in
+    world units) frame the view, so panels that share them share the camera."""
+    image = np.full((size, size, 3), BACKGROUND)
+    if len(triangles) == 0:
+        return image
+    corners = vertices[triangles]
+    cross = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    double_area = np.linalg.norm(cross, axis=1)
+    keep = double_area > 0
+    corners, cross, double_area = corners[keep], cross[keep], double_area[keep]
+    if len(corners) == 0:
+        return image
+    normals = cross / double_area[:, None]
+
+    # About eight samples per covered pixel, so that the splats close up.
+    scale = size / (2 * half_extent)
+    count = int(min(6e6, max(2e5, 8 * 0.5 * double_area.sum() * scale**2)))
+    rng = np.random.default_rng(seed)
+    tri = rng.choice(len(corners), size=count, p=double_area / double_area.sum())
+    r1, r2 = np.sqrt(rng.random(count)), rng.random(count)
+    points = ((1 - r1)[:, None] * corners[tri, 0] + (r1 * (1 - r2))[:, None] * corners[tri, 1]
+              + (r1 * r2)[:, None] * corners[tri, 2])
+
+    cam = (points - center) @ rotation.T
+    px = np.floor(cam[:, 0] * scale + size / 2).astype(np.int64)
+    py = np.floor(size / 2 - cam[:, 1] * scale).astype(np.int64)
+    inside = (px >= 0) & (px < size) & (py >= 0) & (py < size)
+    px, py, depth, tri = px[inside], py[inside], cam[inside, 2], tri[inside]
+    if len(px) == 0:
+        return image
+    pixel = py * size + px
+    order = np.lexsort((depth, pixel))  # by pixel, then nearest (largest z) last
+    last = np.r_[np.nonzero(np.diff(pixel[order]))[0], len(order) - 1]
+    winners = order[last]
+
+    n = normals[tri[winners]] @ rotation.T       # in camera coordinates
+    # Grazing triangles at a silhouette may win a pixel from either side; only a clearly
+    # back-facing surface is inside-out.
+    facing = n[:, 2] > -0.15
+    n_front = np.where(facing[:, None], n, -n)    # light whichever side is seen
+    light = np.array([0.35, 0.55, 1.0]) / np.linalg.norm([0.35, 0.55, 1.0])
+    intensity = 0.25 + 0.75 * np.clip(n_front @ light, 0, 1)
+    color = np.where(facing[:, None], FRONT, BACK) * intensity[:, None]
+    flat = image.reshape(-1, 3)
+    flat[pixel[winners]] = color
+    return image
+
+
+def side_by_side(panels, path, title, azimuth=35, elevation=20, frame=None, size=420):
+    """panels: list of (label, mesh path or None). frame: (center, half_extent), else the
+    first readable mesh's bounding box. Writes one PNG."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    meshes = []
+    for label, mesh_path in panels:
+        try:
+            meshes.append((label, read_mesh(mesh_path) if mesh_path else None))
+        except Exception as e:  # a missing output is a panel that says so
+            meshes.append((f"{label}\n(unreadable: {e})", None))
+    if frame is None:
+        first = next((m for _, m in meshes if m is not None and len(m[0])), None)
+        if first is None:
+            return
+        lo, hi = first[0].min(axis=0), first[0].max(axis=0)
+        frame = ((lo + hi) / 2, 0.55 * np.linalg.norm(hi - lo))
+    center, half_extent = frame
+    rotation = camera(azimuth, elevation)
+
+    fig, axes = plt.subplots(1, len(meshes), figsize=(3.2 * len(meshes), 3.6), squeeze=False)
+    for ax, (label, mesh) in zip(axes[0], meshes):
+        if mesh is None:
+            ax.imshow(np.full((size, size, 3), 0.9))
+            label = label if "\n" in label else f"{label}\n(no output)"
+        else:
+            ax.imshow(render(mesh[0], mesh[1], rotation, np.asarray(center), half_extent, size))
+        ax.set_title(label, fontsize=9)
+        ax.set_axis_off()
+    fig.suptitle(f"{title}   (red = surface seen from inside: inside-out)", fontsize=10)
+    fig.tight_layout(rect=(0, 0, 1, 0.94))
+    fig.savefig(path, dpi=100)
+    plt.close(fig)

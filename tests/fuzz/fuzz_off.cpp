@@ -1,0 +1,9 @@
+// libFuzzer target for the OFF reader (parse_off_buffer).
+#include "fuzz_common.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
+    gmpu::fuzz::run([](const char *d, size_t n, gmpu::io::detail::Want want) {
+        return gmpu::io::detail::parse_off_buffer(d, n, "fuzz.off", want);
+    }, data, size);
+    return 0;
+}
