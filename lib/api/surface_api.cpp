@@ -387,11 +387,10 @@ GMPU_API gmpu_status gmpu_surface_polygonize(gmpu_surface *s, gmpu_mesh **out) {
         auto t0 = Clock::now();
         gmpu::Progress progress(s->progress_fn, s->progress_user, GMPU_STAGE_POLYGONIZE);
         progress.report(0.0, true);
-        int resolution = s->params.resolution > 0 ? s->params.resolution : gmpu::default_resolution(s->tree, s->points);
+        int resolution = s->params.resolution > 0 ? s->params.resolution : gmpu::default_resolution(s->tree);
         const gmpu::MpuFunction mpu(s->tree, s->params.level);
-        const gmpu::SurfaceField f(mpu, s->points, s->measures);
         auto mesh = std::make_unique<gmpu_mesh>();
-        mesh->mesh = gmpu::polygonize(f, s->winding, s->points, s->measures, resolution, s->params, progress);
+        mesh->mesh = gmpu::polygonize(mpu, s->winding, s->points, s->measures, resolution, s->params, progress);
         s->last_resolution = resolution;
         s->seconds[GMPU_STAGE_POLYGONIZE] = since(t0);
         *out = mesh.release();

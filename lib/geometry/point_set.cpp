@@ -58,6 +58,31 @@ struct CollectingResultSet {
     float worstDist() const { return radius_sq; }
 };
 
+// The k nearest points within a radius: the radius prunes the search from the start, which
+// makes queries far from the data (most of the polygonizer's) cheap.
+struct BoundedKnnResultSet {
+    size_t k;
+    float radius_sq;
+    uint32_t *indices;
+    float *dists;
+    size_t count = 0;
+    void init() {}
+    size_t size() const { return count; }
+    bool full() const { return count == k; }
+    float worstDist() const { return count < k ? radius_sq : dists[k - 1]; }
+    bool addPoint(float dist, uint32_t index) {
+        if (dist >= worstDist()) return true;
+        size_t i = count < k ? count++ : k - 1;
+        for (; i > 0 && dists[i - 1] > dist; --i) {
+            dists[i] = dists[i - 1];
+            indices[i] = indices[i - 1];
+        }
+        dists[i] = dist;
+        indices[i] = index;
+        return true;
+    }
+};
+
 }  // namespace
 
 struct PointSet::Index {
@@ -158,14 +183,16 @@ size_t PointSet::count_within(const Eigen::Vector3d &c, double radius, size_t en
 }
 
 void PointSet::nearest(const Eigen::Vector3d &c, size_t k, std::vector<uint32_t> &indices,
-                       std::vector<float> &squared_distances) const {
+                       std::vector<float> &squared_distances, double max_radius) const {
     k = std::min(k, size());
     indices.resize(k);
     squared_distances.resize(k);
     const float q[3] = {float(c[0]), float(c[1]), float(c[2])};
-    size_t found = index_->tree.knnSearch(q, k, indices.data(), squared_distances.data());
-    indices.resize(found);
-    squared_distances.resize(found);
+    const float r2 = std::isfinite(max_radius) ? float(max_radius * max_radius) : INFINITY;
+    BoundedKnnResultSet rs{k, r2, indices.data(), squared_distances.data()};
+    if (k > 0) index_->tree.findNeighbors(rs, q, nanoflann::SearchParams(32, 0.0f, false));
+    indices.resize(rs.count);
+    squared_distances.resize(rs.count);
 }
 
 }  // namespace gmpu

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -49,9 +50,10 @@ public:
     void within(const Eigen::Vector3d &centre, double radius, std::vector<uint32_t> &out) const;
     // Number of points within `radius`, stopping early once `enough` are found.
     size_t count_within(const Eigen::Vector3d &centre, double radius, size_t enough) const;
-    // The k nearest points (indices and squared distances, nearest first).
+    // The k nearest points (indices and squared distances, nearest first), only among those
+    // closer than max_radius (fewer than k, or none, when the ball holds fewer).
     void nearest(const Eigen::Vector3d &centre, size_t k, std::vector<uint32_t> &indices,
-                 std::vector<float> &squared_distances) const;
+                 std::vector<float> &squared_distances, double max_radius = INFINITY) const;
 
 private:
     struct Index;

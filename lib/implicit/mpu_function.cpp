@@ -1,5 +1,6 @@
 #include "implicit/mpu_function.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace gmpu {
@@ -10,56 +11,93 @@ inline double bspline(double t) { return t <= 0.5 ? 0.75 - t * t : 0.5 * (1.5 - 
 inline double bspline_derivative(double t) { return t <= 0.5 ? -2.0 * t : -(1.5 - t); }
 }  // namespace
 
-struct MpuFunction::Sum {
-    double w = 0.0, wq = 0.0;
-    Eigen::Vector3d dw = Eigen::Vector3d::Zero();   // Σ ∇w
-    Eigen::Vector3d dwq = Eigen::Vector3d::Zero();  // Σ ∇(w q)
-    uint32_t fallback = 0;                          // deepest inner cell covering x
-    int fallback_depth = 0;
-};
-
-void MpuFunction::add(const Cell &c, const Eigen::Vector3d &x, Sum &sum, bool want_gradient) const {
-    const Eigen::Vector3d y = x - c.centre;
-    const double d = y.norm();
-    const double t = 1.5 * d / c.radius;
-    const double w = bspline(t);
-    Eigen::Vector3d g;
-    const double q = c.value(x, tree_.pieces, want_gradient ? &g : nullptr);
-    sum.w += w;
-    sum.wq += w * q;
-    if (want_gradient) {
-        Eigen::Vector3d dw = d > 0.0 ? Eigen::Vector3d(bspline_derivative(t) * 1.5 / (c.radius * d) * y)
-                                     : Eigen::Vector3d::Zero();
-        sum.dw += dw;
-        sum.dwq += dw * q + w * g;
+uint32_t MpuFunction::collect(const Eigen::Vector3d &x, std::vector<uint32_t> &out) const {
+    uint32_t deepest = 0;
+    uint32_t stack[8 * (kMaxDepth + 2)];
+    int top = 0;
+    if (covers(tree_.cells[0], x)) stack[top++] = 0;
+    while (top > 0) {
+        const uint32_t i = stack[--top];
+        const Cell &c = tree_.cells[i];
+        if (c.depth >= tree_.cells[deepest].depth) deepest = i;
+        if (is_leaf(c)) {
+            out.push_back(i);
+            continue;
+        }
+        for (int o = 0; o < 8; ++o) {
+            int32_t k = tree_.child(c, o);
+            if (k >= 0 && covers(tree_.cells[size_t(k)], x)) stack[top++] = uint32_t(k);
+        }
     }
+    return deepest;
 }
 
-void MpuFunction::visit(uint32_t index, const Eigen::Vector3d &x, Sum &sum, bool want_gradient) const {
-    const Cell &c = tree_.cells[index];
-    if ((x - c.centre).squaredNorm() >= c.radius * c.radius) return;
-    if (c.is_leaf() || c.depth >= cap_) {
-        add(c, x, sum, want_gradient);
-        return;
+double MpuFunction::blend(const std::vector<uint32_t> &leaves, const Eigen::Vector3d &x,
+                          Eigen::Vector3d *gradient, uint32_t fallback) const {
+    double sw = 0.0, swq = 0.0;
+    Eigen::Vector3d dw_sum = Eigen::Vector3d::Zero(), dwq_sum = Eigen::Vector3d::Zero();
+    Eigen::Vector3d g;
+    for (uint32_t i : leaves) {
+        const Cell &c = tree_.cells[i];
+        const Eigen::Vector3d y = x - c.centre;
+        const double d2 = y.squaredNorm();
+        if (d2 >= c.radius * c.radius) continue;
+        const double d = std::sqrt(d2);
+        const double t = 1.5 * d / c.radius;
+        const double w = bspline(t);
+        const double q = c.value(x, tree_.pieces, gradient ? &g : nullptr);
+        sw += w;
+        swq += w * q;
+        if (gradient) {
+            Eigen::Vector3d dw = d > 0.0 ? Eigen::Vector3d(bspline_derivative(t) * 1.5 / (c.radius * d) * y)
+                                         : Eigen::Vector3d::Zero();
+            dw_sum += dw;
+            dwq_sum += dw * q + w * g;
+        }
     }
-    if (c.depth >= sum.fallback_depth) sum.fallback = index, sum.fallback_depth = c.depth;
-    for (int o = 0; o < 8; ++o) {
-        int32_t k = tree_.child(c, o);
-        if (k >= 0) visit(uint32_t(k), x, sum, want_gradient);
-    }
+    if (!(sw > 0.0)) return tree_.cells[fallback].value(x, tree_.pieces, gradient);
+    const double f = swq / sw;
+    if (gradient) *gradient = (dwq_sum - f * dw_sum) / sw;
+    return f;
 }
 
 double MpuFunction::value(const Eigen::Vector3d &x, Eigen::Vector3d *gradient) const {
-    Sum sum;
-    visit(0, x, sum, gradient != nullptr);
-    if (!(sum.w > 0.0)) {
-        // No leaf reaches x: the deepest cell that does stands in (beyond the root's ball,
-        // the root itself).
-        return tree_.cells[sum.fallback].value(x, tree_.pieces, gradient);
+    thread_local std::vector<uint32_t> leaves;
+    leaves.clear();
+    // No leaf reaches x: the deepest cell that does stands in (beyond the root's ball,
+    // the root itself).
+    const uint32_t fallback = collect(x, leaves);
+    std::sort(leaves.begin(), leaves.end());
+    return blend(leaves, x, gradient, fallback);
+}
+
+void MpuFunction::gather(const Eigen::AlignedBox3d &box, std::vector<uint32_t> &leaves) const {
+    leaves.clear();
+    std::vector<uint32_t> stack{0};
+    while (!stack.empty()) {
+        const uint32_t i = stack.back();
+        stack.pop_back();
+        const Cell &c = tree_.cells[i];
+        if (box.squaredExteriorDistance(c.centre) >= c.radius * c.radius) continue;
+        if (is_leaf(c)) {
+            leaves.push_back(i);
+            continue;
+        }
+        for (int o = 0; o < 8; ++o) {
+            int32_t k = tree_.child(c, o);
+            if (k >= 0) stack.push_back(uint32_t(k));
+        }
     }
-    const double f = sum.wq / sum.w;
-    if (gradient) *gradient = (sum.dwq - f * sum.dw) / sum.w;
-    return f;
+    std::sort(leaves.begin(), leaves.end());
+}
+
+double MpuFunction::value_among(const std::vector<uint32_t> &leaves, const Eigen::Vector3d &x,
+                                Eigen::Vector3d *gradient) const {
+    // blend() skips the leaves that do not cover x, so the covering ones are summed in the
+    // same order as value() sums them; only the fallback needs the walk.
+    for (uint32_t i : leaves)
+        if (covers(tree_.cells[i], x)) return blend(leaves, x, gradient, 0);
+    return value(x, gradient);
 }
 
 }  // namespace gmpu

@@ -3,14 +3,21 @@
 // w_i(x) = b(1.5 |x − c_i| / R_i), and its analytic gradient. Read-only: safe to share
 // between threads.
 //
+// The sum always runs over the covering leaves in increasing cell index, whichever way they
+// were found (a walk down the octree, or a list gathered once for a whole region), so
+// every path gives bit-identical values — the polygonizer relies on that for neighbouring
+// blocks to agree on shared corners.
+//
 // Where no leaf covers x (far from the data) the deepest cell that does cover it stands in
 // (its coarser fit is the best estimate there); beyond the root's ball, the root's fit.
 // (Far from the data the field the library hands out is signed otherwise anyway, see
-// surface_field.hpp.)
-// A level cap L (paper Fig. 7) treats the cells of level L as leaves.
+// surface_field.hpp.) A level cap L (paper Fig. 7) treats the cells of level L as leaves.
 #pragma once
 
+#include <vector>
+
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "geometry/octree.hpp"
 
@@ -23,12 +30,24 @@ public:
     // f and (optionally) ∇f at x, in the normalised frame.
     double value(const Eigen::Vector3d &x, Eigen::Vector3d *gradient) const;
 
+    // The leaves (at the level cap) whose support meets `box`, in increasing index.
+    void gather(const Eigen::AlignedBox3d &box, std::vector<uint32_t> &leaves) const;
+
+    // value() for an x inside the box `leaves` was gathered for: same result, faster.
+    double value_among(const std::vector<uint32_t> &leaves, const Eigen::Vector3d &x,
+                       Eigen::Vector3d *gradient) const;
+
     const Octree &tree() const { return tree_; }
 
 private:
-    struct Sum;
-    void visit(uint32_t index, const Eigen::Vector3d &x, Sum &sum, bool want_gradient) const;
-    void add(const Cell &c, const Eigen::Vector3d &x, Sum &sum, bool want_gradient) const;
+    bool is_leaf(const Cell &c) const { return c.is_leaf() || c.depth >= cap_; }
+    bool covers(const Cell &c, const Eigen::Vector3d &x) const {
+        return (x - c.centre).squaredNorm() < c.radius * c.radius;
+    }
+    // Covering leaves of x in `out` (unsorted); returns the deepest covering cell.
+    uint32_t collect(const Eigen::Vector3d &x, std::vector<uint32_t> &out) const;
+    double blend(const std::vector<uint32_t> &sorted_leaves, const Eigen::Vector3d &x,
+                 Eigen::Vector3d *gradient, uint32_t fallback) const;
     const Octree &tree_;
     int cap_;
 };

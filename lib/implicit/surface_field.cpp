@@ -14,22 +14,26 @@ constexpr double kTrustSpacings = 1.5;
 constexpr size_t kSideVotes = 8;
 }  // namespace
 
-bool SurfaceField::trusted(const Eigen::Vector3d &x, double min_trust, double &distance, uint32_t &nearest) const {
+bool SurfaceField::trusted(const Eigen::Vector3d &x) const {
     thread_local std::vector<uint32_t> idx;
-    thread_local std::vector<float> d2;
-    points_.nearest(x, 1, idx, d2);
-    nearest = idx[0];
-    distance = std::sqrt(double(d2[0]));
-    return distance <= std::max(double(measures_.trust_radius[nearest]), min_trust);
+    idx.clear();
+    // A little wider than needed: the kd-tree compares float distances.
+    points_.within(x, widest_trust() * (1.0 + 1e-5) + 1e-7, idx);
+    for (uint32_t i : idx)
+        if ((x - points_.point(i)).norm() <= trust_radius(i)) return true;
+    return false;
 }
 
-double SurfaceField::far_value(const Eigen::Vector3d &x, double distance, uint32_t nearest,
-                               Eigen::Vector3d *gradient) const {
+double SurfaceField::far_value(const Eigen::Vector3d &x, Eigen::Vector3d *gradient) const {
     // Hoppe's side test, voted over the k nearest points (weighted by closeness) so that
     // one poorly estimated normal — at the tip of a thin part, say — cannot flip a region.
     thread_local std::vector<uint32_t> idx;
     thread_local std::vector<float> d2;
-    points_.nearest(x, kSideVotes, idx, d2);
+    points_.nearest(x, kSideVotes, idx, d2, reach_);
+    if (idx.empty()) {
+        if (gradient) gradient->setZero();
+        return -reach_;  // beyond the reach of every point: outside
+    }
     double vote = 0.0;
     for (size_t k = 0; k < idx.size(); ++k) {
         const uint32_t i = idx[k];
@@ -38,18 +42,21 @@ double SurfaceField::far_value(const Eigen::Vector3d &x, double distance, uint32
         vote += (side < 0.0 ? 1.0 : -1.0) / (std::sqrt(double(d2[k])) + 1e-12);
     }
     const double sign = vote > 0.0 ? 1.0 : -1.0;  // behind the outward normals: inside
+    const double distance = std::sqrt(double(d2[0]));
     if (gradient) {
-        Eigen::Vector3d away = x - points_.point(nearest);
+        Eigen::Vector3d away = x - points_.point(idx[0]);
         *gradient = distance > 0.0 ? Eigen::Vector3d(-sign * away / distance) : Eigen::Vector3d::Zero();
     }
     return sign * distance;
 }
 
-double SurfaceField::value(const Eigen::Vector3d &x, Eigen::Vector3d *gradient, double min_trust) const {
-    double distance;
-    uint32_t nearest;
-    if (trusted(x, min_trust, distance, nearest)) return mpu_.value(x, gradient);
-    return far_value(x, distance, nearest, gradient);
+double SurfaceField::value(const Eigen::Vector3d &x, Eigen::Vector3d *gradient) const {
+    return trusted(x) ? mpu_.value(x, gradient) : far_value(x, gradient);
+}
+
+double SurfaceField::value_among(const std::vector<uint32_t> &leaves, const Eigen::Vector3d &x,
+                                 Eigen::Vector3d *gradient) const {
+    return trusted(x) ? mpu_.value_among(leaves, x, gradient) : far_value(x, gradient);
 }
 
 void measure_points(const PointSet &points, unsigned threads, Progress &progress, PointMeasures &out) {
@@ -65,6 +72,8 @@ void measure_points(const PointSet &points, unsigned threads, Progress &progress
         out.trust_radius[i] = float(kTrustSpacings * rk);
     }, 0.0, 0.0, 512);
     progress.throw_if_cancelled();
+    out.widest_trust = 0.0;
+    for (float r : out.trust_radius) out.widest_trust = std::max(out.widest_trust, double(r));
 }
 
 }  // namespace gmpu

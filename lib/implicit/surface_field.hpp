@@ -3,7 +3,7 @@
 //
 // Local quadrics are only valid near the points they were fitted to; extended into empty
 // space they cross zero in spurious sheets (a known MPU pitfall). So a query x is
-// "trusted" when it lies within the trust radius of its nearest input point (a few local
+// "trusted" when it lies within the trust radius of some input point (a few local
 // spacings, never less than two polygonizer cubes); there f is the MPU blend. Farther out
 // f = ±d(x), the distance to the nearest point, signed by which side of the nearby points'
 // oriented normals x lies on (Hoppe's test, voted over the 8 nearest points; reliable once
@@ -12,6 +12,7 @@
 // surface can appear away from the data.
 #pragma once
 
+#include <cmath>
 #include <vector>
 
 #include <Eigen/Core>
@@ -26,29 +27,43 @@ struct PointMeasures {
     std::vector<float> normals;       // unit outward, 3 per point
     std::vector<float> area;          // surface area each point stands for
     std::vector<float> trust_radius;  // normalised units
+    double widest_trust = 0.0;        // max of trust_radius
 };
 
 class SurfaceField {
 public:
-    SurfaceField(const MpuFunction &mpu, const PointSet &points, const PointMeasures &measures)
-        : mpu_(mpu), points_(points), measures_(measures) {}
+    // `min_trust` widens every trust radius to at least that (the polygonizer passes two
+    // cube sizes, so every cube the surface crosses has its corners trusted). `reach`
+    // bounds the neighbour searches of untrusted queries (infinite for general use; the
+    // polygonizer knows every query it makes has a point within its band's reach, and
+    // bounded searches are much cheaper far from the data).
+    SurfaceField(const MpuFunction &mpu, const PointSet &points, const PointMeasures &measures,
+                 double min_trust = 0.0, double reach = INFINITY)
+        : mpu_(mpu), points_(points), measures_(measures), min_trust_(min_trust), reach_(reach) {}
 
-    // f and optionally ∇f at x (normalised frame). `min_trust` widens every trust radius
-    // to at least that (the polygonizer passes two cube sizes).
-    double value(const Eigen::Vector3d &x, Eigen::Vector3d *gradient, double min_trust = 0.0) const;
+    // f and optionally ∇f at x (normalised frame).
+    double value(const Eigen::Vector3d &x, Eigen::Vector3d *gradient) const;
 
-    // Distance to the nearest point and whether x is trusted; `nearest` receives its index.
-    bool trusted(const Eigen::Vector3d &x, double min_trust, double &distance, uint32_t &nearest) const;
+    // value() for x inside the box `leaves` was gathered for (MpuFunction::gather).
+    double value_among(const std::vector<uint32_t> &leaves, const Eigen::Vector3d &x,
+                       Eigen::Vector3d *gradient) const;
 
-    // The far-field value at an untrusted x: ±distance, signed by the nearest normals.
-    double far_value(const Eigen::Vector3d &x, double distance, uint32_t nearest, Eigen::Vector3d *gradient) const;
+    // Whether x lies within some point's trust radius (widened to min_trust).
+    bool trusted(const Eigen::Vector3d &x) const;
+    // The far field: ±(distance to the nearest point), signed by the nearby points' normals.
+    double far_value(const Eigen::Vector3d &x, Eigen::Vector3d *gradient) const;
+    // Trust radius of point i, widened to min_trust.
+    double trust_radius(uint32_t i) const { return std::max(double(measures_.trust_radius[i]), min_trust_); }
+    double widest_trust() const { return std::max(measures_.widest_trust, min_trust_); }
 
     const MpuFunction &mpu() const { return mpu_; }
+    const PointSet &points() const { return points_; }
 
 private:
     const MpuFunction &mpu_;
     const PointSet &points_;
     const PointMeasures &measures_;
+    double min_trust_, reach_;
 };
 
 // Normals are given; area and trust radius come from the k nearest neighbours.

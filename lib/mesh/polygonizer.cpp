@@ -1,164 +1,114 @@
 #include "mesh/polygonizer.hpp"
 
 #include <algorithm>
-#include <array>
+#include <atomic>
 #include <cmath>
 #include <string>
 
 #include "core/parallel.hpp"
+#include "mesh/block_grid.hpp"
 #include "mesh/marching_tetrahedra.hpp"
 
 namespace gmpu {
 
 namespace {
 
-constexpr int B = 8;  // cubes per block side
-
-struct Grid {
-    Eigen::Vector3d origin;
-    double h;
-    int64_t n[3];       // corners per axis minus one (cubes), a multiple of B
-    int64_t blocks[3];  // blocks per axis
-
-    Eigen::Vector3d corner(int64_t x, int64_t y, int64_t z) const {
-        return origin + h * Eigen::Vector3d(double(x), double(y), double(z));
-    }
-    uint64_t corner_id(int64_t x, int64_t y, int64_t z) const {
-        return uint64_t(x + (n[0] + 1) * (y + (n[1] + 1) * z));
-    }
-    int64_t block_id(int64_t x, int64_t y, int64_t z) const { return x + blocks[0] * (y + blocks[1] * z); }
-};
-
-// `dilation`: how many blocks the band reaches beyond the blocks holding points.
-Grid make_grid(const PointSet &points, int resolution, int dilation) {
-    Grid g;
-    g.h = 1.0 / resolution;  // the longest side of the normalised box is 1
-    const double pad = (dilation + 1) * B * g.h;  // keeps the band a block off the grid's edge
-    g.origin = points.box_min() - Eigen::Vector3d::Constant(pad);
-    for (int d = 0; d < 3; ++d) {
-        double extent = points.box_max()[d] - points.box_min()[d] + 2.0 * pad;
-        g.blocks[d] = std::max<int64_t>(1, int64_t(std::ceil(extent / (g.h * B))));
-        g.n[d] = g.blocks[d] * B;
-    }
-    return g;
-}
-
-// Far regions: flood fill of the blocks outside the band (6-connected). Region 0 touches
-// the grid's edge and is outside; enclosed regions get their sign from the winding number.
-struct Regions {
-    std::vector<uint8_t> band;     // per block
-    std::vector<int8_t> sign;      // per block: 0 in the band, else its region's sign
-};
-
-Regions find_regions(const Grid &g, const PointSet &points, const WindingField &winding, int dilation) {
-    const int64_t nb = g.blocks[0] * g.blocks[1] * g.blocks[2];
-    Regions r;
-    std::vector<uint8_t> has_point(size_t(nb), 0);
-    for (size_t i = 0; i < points.size(); ++i) {
-        Eigen::Vector3d q = (points.point(i) - g.origin) / (g.h * B);
-        int64_t b[3];
-        for (int d = 0; d < 3; ++d) b[d] = std::clamp<int64_t>(int64_t(q[d]), 0, g.blocks[d] - 1);
-        has_point[size_t(g.block_id(b[0], b[1], b[2]))] = 1;
-    }
-    r.band.assign(size_t(nb), 0);
-    for (int64_t z = 0; z < g.blocks[2]; ++z)
-        for (int64_t y = 0; y < g.blocks[1]; ++y)
-            for (int64_t x = 0; x < g.blocks[0]; ++x) {
-                if (!has_point[size_t(g.block_id(x, y, z))]) continue;
-                for (int64_t dz = -dilation; dz <= dilation; ++dz)
-                    for (int64_t dy = -dilation; dy <= dilation; ++dy)
-                        for (int64_t dx = -dilation; dx <= dilation; ++dx) {
-                            int64_t a = x + dx, b = y + dy, c = z + dz;
-                            if (a < 0 || b < 0 || c < 0 || a >= g.blocks[0] || b >= g.blocks[1] || c >= g.blocks[2])
-                                continue;
-                            r.band[size_t(g.block_id(a, b, c))] = 1;
-                        }
-            }
-
-    std::vector<int32_t> region(size_t(nb), -1);
-    std::vector<int8_t> region_sign;
-    std::vector<int64_t> stack;
-    const int64_t step[3] = {1, g.blocks[0], g.blocks[0] * g.blocks[1]};
-    int32_t regions = 0;
-    for (int64_t s = 0; s < nb; ++s) {
-        if (r.band[size_t(s)] || region[size_t(s)] >= 0) continue;
-        // The first far block in scan order is at the grid's corner: region 0 is outside.
-        // Enclosed regions (cavities, the inside of thick parts) ask the winding number.
-        const int32_t id = regions++;
-        {
-            int64_t pos[3] = {s % g.blocks[0], (s / g.blocks[0]) % g.blocks[1], s / (g.blocks[0] * g.blocks[1])};
-            Eigen::Vector3d c = g.origin + g.h * B * (Eigen::Vector3d(double(pos[0]), double(pos[1]), double(pos[2])) +
-                                                      Eigen::Vector3d::Constant(0.5));
-            region_sign.push_back(id > 0 && winding.winding(c) > 0.5 ? 1 : -1);
-        }
-        region[size_t(s)] = id;
-        stack.push_back(s);
-        while (!stack.empty()) {
-            int64_t b = stack.back();
-            stack.pop_back();
-            int64_t pos[3] = {b % g.blocks[0], (b / g.blocks[0]) % g.blocks[1], b / (g.blocks[0] * g.blocks[1])};
-            for (int d = 0; d < 3; ++d)
-                for (int side = -1; side <= 1; side += 2) {
-                    int64_t p = pos[d] + side;
-                    if (p < 0 || p >= g.blocks[d]) continue;
-                    int64_t nbk = b + side * step[d];
-                    if (r.band[size_t(nbk)]) continue;
-                    if (region[size_t(nbk)] < 0) {
-                        region[size_t(nbk)] = id;
-                        stack.push_back(nbk);
-                    }
-                }
-        }
-    }
-    r.sign.assign(size_t(nb), 0);
-    for (int64_t b = 0; b < nb; ++b)
-        if (!r.band[size_t(b)]) r.sign[size_t(b)] = region_sign[size_t(region[size_t(b)])];
-    return r;
-}
-
-// Sign imposed on a corner by the far blocks touching it (0: none). Depends only on the
-// corner, so every block sharing the corner sees the same value.
-int8_t forced_sign(const Grid &g, const Regions &r, int64_t x, int64_t y, int64_t z) {
-    int64_t lo[3], hi[3];
-    const int64_t c[3] = {x, y, z};
-    for (int d = 0; d < 3; ++d) {
-        hi[d] = std::min(c[d] / B, g.blocks[d] - 1);
-        lo[d] = (c[d] % B == 0 && c[d] > 0) ? c[d] / B - 1 : hi[d];
-    }
-    int8_t s = 0;
-    for (int64_t bz = lo[2]; bz <= hi[2]; ++bz)
-        for (int64_t by = lo[1]; by <= hi[1]; ++by)
-            for (int64_t bx = lo[0]; bx <= hi[0]; ++bx) {
-                int8_t v = r.sign[size_t(g.block_id(bx, by, bz))];
-                if (v < 0) return -1;  // outside wins a tie: it is never wrong to close a leak
-                if (v > 0) s = 1;
-            }
-    return s;
-}
+constexpr int B = BlockGrid::B;
 
 struct BlockOutput {
-    std::vector<uint64_t> vertex_key;         // edge key per vertex
+    std::vector<uint64_t> vertex_key;         // grid edge per vertex: corner id × 8 + direction
     std::vector<Eigen::Vector3d> vertex_pos;  // normalised frame
-    std::vector<uint32_t> triangles;          // local vertex indices
+    std::vector<Eigen::Vector3d> vertex_grad;
+    std::vector<uint32_t> triangles;          // block-local vertex indices
 };
 
-// Marching tetrahedra over one band block.
-void polygonize_block(const Grid &g, const Regions &r, const SurfaceField &f, int64_t bx, int64_t by,
-                      int64_t bz, BlockOutput &out) {
-    constexpr int C = B + 1;
-    thread_local std::vector<double> value(C * C * C);
-    thread_local std::vector<int32_t> slot(C * C * C * 8);
-    const int64_t x0 = bx * B, y0 = by * B, z0 = bz * B;
+// Values at the (B+1)³ corners of one band block. Each corner's value depends on its
+// position alone (never on the block), so neighbouring blocks agree on shared corners:
+//  - touching a far block: that region's sign;
+//  - within some point's trust radius: the MPU blend;
+//  - otherwise: the far field (a signed distance by the nearby normals), sampled on the
+//    coarse lattice of every fourth corner and interpolated — its sign only matters away
+//    from the data, where it varies slowly, and this costs 1/64 of the neighbour searches.
+void corner_values(const BlockGrid &g, const SurfaceField &f, const std::vector<uint32_t> &leaves,
+                   const int64_t origin[3], std::vector<double> &value) {
+    constexpr int C = B + 1, S = 4, CC = B / S + 1;  // coarse lattice step and size
     auto local = [](int i, int j, int k) { return i + C * (j + C * k); };
+
+    // Trust by splatting every nearby point's ball onto the corners.
+    thread_local std::vector<uint8_t> trusted(C * C * C);
+    thread_local std::vector<uint32_t> near;
+    std::fill(trusted.begin(), trusted.end(), 0);
+    const Eigen::Vector3d lo = g.corner(origin[0], origin[1], origin[2]);
+    const Eigen::Vector3d centre = lo + Eigen::Vector3d::Constant(0.5 * B * g.h);
+    near.clear();
+    f.points().within(centre, 0.5 * std::sqrt(3.0) * B * g.h + f.widest_trust() * (1.0 + 1e-5) + 1e-7, near);
+    for (uint32_t p : near) {
+        const Eigen::Vector3d q = f.points().point(p);
+        const double r = f.trust_radius(p);
+        int a[3], b[3];
+        for (int d = 0; d < 3; ++d) {
+            a[d] = std::max(0, int(std::ceil((q[d] - r - lo[d]) / g.h)));
+            b[d] = std::min(B, int(std::floor((q[d] + r - lo[d]) / g.h)));
+        }
+        for (int k = a[2]; k <= b[2]; ++k)
+            for (int j = a[1]; j <= b[1]; ++j)
+                for (int i = a[0]; i <= b[0]; ++i) {
+                    uint8_t &t = trusted[size_t(local(i, j, k))];
+                    if (!t && (g.corner(origin[0] + i, origin[1] + j, origin[2] + k) - q).norm() <= r) t = 1;
+                }
+    }
+
+    double coarse[CC * CC * CC];
+    bool coarse_done[CC * CC * CC] = {};
+    auto far = [&](int i, int j, int k) {
+        const int c = i / S + CC * (j / S + CC * (k / S));
+        if (!coarse_done[c]) {
+            coarse[c] = f.far_value(g.corner(origin[0] + i, origin[1] + j, origin[2] + k), nullptr);
+            coarse_done[c] = true;
+        }
+        return coarse[c];
+    };
     for (int k = 0; k < C; ++k)
         for (int j = 0; j < C; ++j)
             for (int i = 0; i < C; ++i) {
-                double v = f.value(g.corner(x0 + i, y0 + j, z0 + k), nullptr, 2.0 * g.h);
-                if (!std::isfinite(v)) v = -1.0;
-                int8_t s = forced_sign(g, r, x0 + i, y0 + j, z0 + k);
-                if (s != 0 && (v > 0) != (s > 0)) v = s > 0 ? std::max(std::abs(v), 1e-12) : -std::abs(v);
+                const int8_t forced = g.forced_sign(origin[0] + i, origin[1] + j, origin[2] + k);
+                double v;
+                if (forced != 0) {
+                    v = forced * g.h;
+                } else if (trusted[size_t(local(i, j, k))]) {
+                    v = f.mpu().value_among(leaves, g.corner(origin[0] + i, origin[1] + j, origin[2] + k), nullptr);
+                } else {
+                    // Trilinear in the coarse cell holding the corner.
+                    const int ci = std::min(i / S, CC - 2) * S, cj = std::min(j / S, CC - 2) * S,
+                              ck = std::min(k / S, CC - 2) * S;
+                    const double u = double(i - ci) / S, w = double(j - cj) / S, t = double(k - ck) / S;
+                    v = 0.0;
+                    for (int c = 0; c < 8; ++c) {
+                        const int di = c & 1, dj = c >> 1 & 1, dk = c >> 2 & 1;
+                        const double weight = (di ? u : 1 - u) * (dj ? w : 1 - w) * (dk ? t : 1 - t);
+                        if (weight > 0.0) v += weight * far(ci + S * di, cj + S * dj, ck + S * dk);
+                    }
+                    if (v == 0.0) v = -g.h;  // exactly between: outside, like every tie
+                }
+                if (!std::isfinite(v)) v = -g.h;
                 value[size_t(local(i, j, k))] = v;
             }
+}
+
+// Marching tetrahedra over one band block.
+void polygonize_block(const BlockGrid &g, const SurfaceField &f, int64_t block, BlockOutput &out) {
+    constexpr int C = B + 1;
+    thread_local std::vector<double> value(C * C * C);
+    thread_local std::vector<int32_t> slot(C * C * C * 8);
+    thread_local std::vector<uint32_t> leaves;
+    f.mpu().gather(g.block_box(block), leaves);
+
+    int64_t pos[3];
+    g.block_position(block, pos);
+    const int64_t x0 = pos[0] * B, y0 = pos[1] * B, z0 = pos[2] * B;
+    const int64_t origin[3] = {x0, y0, z0};
+    auto local = [](int i, int j, int k) { return i + C * (j + C * k); };
+    corner_values(g, f, leaves, origin, value);
     std::fill(slot.begin(), slot.end(), -1);
 
     auto vertex = [&](int i, int j, int k, const mt::Edge &e) -> uint32_t {
@@ -169,9 +119,13 @@ void polygonize_block(const Grid &g, const Regions &r, const SurfaceField &f, in
         if (s >= 0) return uint32_t(s);
         const double va = value[size_t(local(ai, aj, ak))], vb = value[size_t(local(bi, bj, bk))];
         const double t = std::clamp(va / (va - vb), 0.0, 1.0);
-        Eigen::Vector3d pa = g.corner(x0 + ai, y0 + aj, z0 + ak), pb = g.corner(x0 + bi, y0 + bj, z0 + bk);
+        const Eigen::Vector3d pa = g.corner(x0 + ai, y0 + aj, z0 + ak), pb = g.corner(x0 + bi, y0 + bj, z0 + bk);
+        const Eigen::Vector3d p = pa + t * (pb - pa);
+        Eigen::Vector3d grad;
+        f.mpu().value_among(leaves, p, &grad);
         s = int32_t(out.vertex_pos.size());
-        out.vertex_pos.push_back(pa + t * (pb - pa));
+        out.vertex_pos.push_back(p);
+        out.vertex_grad.push_back(grad);
         out.vertex_key.push_back(g.corner_id(x0 + ai, y0 + aj, z0 + ak) * 8 + uint64_t(dir));
         return uint32_t(s);
     };
@@ -194,10 +148,37 @@ void polygonize_block(const Grid &g, const Regions &r, const SurfaceField &f, in
             }
 }
 
+// One vertex per grid edge across blocks: sort every block's vertices by edge key.
+Mesh weld(std::vector<BlockOutput> &blocks, const Normalisation &norm, Progress &progress) {
+    std::vector<std::pair<uint64_t, uint64_t>> keyed;  // (edge key, block << 32 | local index)
+    for (size_t b = 0; b < blocks.size(); ++b)
+        for (size_t v = 0; v < blocks[b].vertex_key.size(); ++v) keyed.push_back({blocks[b].vertex_key[v], uint64_t(b) << 32 | v});
+    progress.throw_if_cancelled();
+    std::sort(keyed.begin(), keyed.end());
+    progress.throw_if_cancelled();
+
+    Mesh mesh;
+    std::vector<std::vector<uint32_t>> remap(blocks.size());
+    for (size_t b = 0; b < blocks.size(); ++b) remap[b].resize(blocks[b].vertex_key.size());
+    for (size_t k = 0; k < keyed.size(); ++k) {
+        const size_t b = keyed[k].second >> 32, v = keyed[k].second & 0xffffffffu;
+        if (k == 0 || keyed[k].first != keyed[k - 1].first) {
+            const Eigen::Vector3d p = norm.to_world(blocks[b].vertex_pos[v]);
+            Eigen::Vector3d n = -blocks[b].vertex_grad[v].normalized();  // f grows inward
+            if (!n.allFinite()) n = Eigen::Vector3d::UnitZ();
+            mesh.vertices.insert(mesh.vertices.end(), {p[0], p[1], p[2]});
+            mesh.normals.insert(mesh.normals.end(), {n[0], n[1], n[2]});
+        }
+        remap[b][v] = uint32_t(mesh.vertex_count() - 1);
+    }
+    for (size_t b = 0; b < blocks.size(); ++b)
+        for (uint32_t v : blocks[b].triangles) mesh.triangles.push_back(remap[b][v]);
+    return mesh;
+}
+
 }  // namespace
 
-int default_resolution(const Octree &tree, const PointSet &points) {
-    (void)points;
+int default_resolution(const Octree &tree) {
     // Half the median size of the leaves that hold points: the grid then resolves every
     // local fit with about two cubes across.
     std::vector<double> sizes;
@@ -205,74 +186,39 @@ int default_resolution(const Octree &tree, const PointSet &points) {
         if (c.is_leaf() && c.point_end > c.point_begin) sizes.push_back(c.size);
     if (sizes.empty()) return 64;
     std::nth_element(sizes.begin(), sizes.begin() + long(sizes.size() / 2), sizes.end());
-    double h = 0.5 * sizes[sizes.size() / 2];
+    const double h = 0.5 * sizes[sizes.size() / 2];
     return std::clamp(int(std::ceil(1.0 / h)), 32, 1024);
 }
 
-Mesh polygonize(const SurfaceField &f, const WindingField &winding, const PointSet &points,
+Mesh polygonize(const MpuFunction &mpu, const WindingField &winding, const PointSet &points,
                 const PointMeasures &measures, int resolution, const Params &params, Progress &progress) {
-    // The band must hold every trusted corner, so it reaches past the widest trust radius
-    // (its 99th percentile: one isolated outlier must not widen it everywhere).
-    std::vector<float> trust(measures.trust_radius);
-    std::nth_element(trust.begin(), trust.begin() + long(trust.size() * 99 / 100), trust.end());
-    const double h = 1.0 / resolution;
-    const int dilation = std::clamp(1 + int(double(trust[trust.size() * 99 / 100]) / (h * B)), 1, 3);
-    const Grid g = make_grid(points, resolution, dilation);
-    const Regions r = find_regions(g, points, winding, dilation);
+    const double h = 1.0 / resolution, min_trust = 2.0 * h;
+    const BlockGrid g(points, resolution, measures.trust_radius, min_trust, winding);
+    // A band block meets some point's reach, so each of its corners has a point within that
+    // reach plus the block's diagonal: the bound for every neighbour search below.
+    const double reach = std::max(measures.widest_trust, min_trust) + B * std::sqrt(3.0) * h + h;
+    const SurfaceField f(mpu, points, measures, min_trust, reach);
     std::vector<int64_t> band;
-    for (int64_t b = 0; b < int64_t(r.band.size()); ++b)
-        if (r.band[size_t(b)]) band.push_back(b);
+    for (int64_t b = 0; b < int64_t(g.block_count()); ++b)
+        if (g.band[size_t(b)]) band.push_back(b);
     progress.report(0.02);
+    progress.throw_if_cancelled();
 
     std::vector<BlockOutput> blocks(band.size());
-    const unsigned threads = resolve_threads(params.threads);
     std::atomic<uint64_t> triangles{0};
-    parallel_for(0, band.size(), threads, progress, [&](size_t i) {
-        int64_t b = band[i];
-        polygonize_block(g, r, f, b % g.blocks[0], (b / g.blocks[0]) % g.blocks[1],
-                         b / (g.blocks[0] * g.blocks[1]), blocks[i]);
-        uint64_t total = triangles.fetch_add(blocks[i].triangles.size() / 3) + blocks[i].triangles.size() / 3;
-        if (double(total) > params.max_triangles)
+    const double total = double(band.size()) / 0.93;
+    parallel_for(0, band.size(), resolve_threads(params.threads), progress, [&](size_t i) {
+        polygonize_block(g, f, band[i], blocks[i]);
+        const uint64_t made = blocks[i].triangles.size() / 3;
+        if (double(triangles.fetch_add(made) + made) > params.max_triangles)
             throw Error(GMPU_ERROR_LIMIT_EXCEEDED,
                         "the mesh needs more than GMPU_PARAM_MAX_TRIANGLES = " +
                             std::to_string(uint64_t(params.max_triangles)) +
                             " triangles; lower GMPU_PARAM_RESOLUTION or raise the cap");
-    }, 0.02 * double(band.size()) / 0.9, double(band.size()) / 0.9, 4);
+    }, 0.02 * total, total, 4);
     progress.throw_if_cancelled();
-
-    // Weld: one vertex per grid edge across blocks (sort by edge key).
-    std::vector<std::pair<uint64_t, uint64_t>> keyed;  // (edge key, block << 32 | local)
-    for (size_t b = 0; b < blocks.size(); ++b)
-        for (size_t v = 0; v < blocks[b].vertex_key.size(); ++v)
-            keyed.push_back({blocks[b].vertex_key[v], uint64_t(b) << 32 | v});
-    std::sort(keyed.begin(), keyed.end());
-    std::vector<std::vector<uint32_t>> remap(blocks.size());
-    for (size_t b = 0; b < blocks.size(); ++b) remap[b].resize(blocks[b].vertex_key.size());
-    Mesh mesh;
-    const Normalisation &norm = points.normalisation();
-    for (size_t k = 0; k < keyed.size(); ++k) {
-        if (k == 0 || keyed[k].first != keyed[k - 1].first) {
-            size_t b = keyed[k].second >> 32, v = keyed[k].second & 0xffffffffu;
-            Eigen::Vector3d p = norm.to_world(blocks[b].vertex_pos[v]);
-            mesh.vertices.insert(mesh.vertices.end(), {p[0], p[1], p[2]});
-        }
-        remap[keyed[k].second >> 32][keyed[k].second & 0xffffffffu] = uint32_t(mesh.vertex_count() - 1);
-    }
-    for (size_t b = 0; b < blocks.size(); ++b)
-        for (uint32_t v : blocks[b].triangles) mesh.triangles.push_back(remap[b][v]);
     progress.report(0.95);
-
-    // Outward unit normals: −∇f at each vertex.
-    mesh.normals.resize(mesh.vertices.size());
-    parallel_for(0, mesh.vertex_count(), threads, progress, [&](size_t v) {
-        Eigen::Vector3d p(mesh.vertices[3 * v], mesh.vertices[3 * v + 1], mesh.vertices[3 * v + 2]);
-        Eigen::Vector3d grad;
-        f.value(norm.to_unit(p), &grad, 2.0 * g.h);
-        Eigen::Vector3d n = -grad.normalized();
-        if (!n.allFinite()) n = Eigen::Vector3d::UnitZ();
-        for (int d = 0; d < 3; ++d) mesh.normals[3 * v + d] = n[d];
-    }, 0.95 * double(mesh.vertex_count()) / 0.05, double(mesh.vertex_count()) / 0.05, 1024);
-    progress.throw_if_cancelled();
+    Mesh mesh = weld(blocks, points.normalisation(), progress);
     progress.report(1.0, true);
     return mesh;
 }

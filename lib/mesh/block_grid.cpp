@@ -1,0 +1,103 @@
+#include "mesh/block_grid.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace gmpu {
+
+BlockGrid::BlockGrid(const PointSet &points, int resolution, const std::vector<float> &reach, double min_reach,
+                     const WindingField &winding) {
+    h = 1.0 / resolution;  // the longest side of the normalised box is 1
+    double widest = min_reach;
+    for (float r : reach) widest = std::max(widest, double(r));
+    // One spare block beyond the widest reach keeps the band off the grid's edge, so the
+    // region touching the edge surrounds everything.
+    const double pad = widest + B * h;
+    origin = points.box_min() - Eigen::Vector3d::Constant(pad);
+    for (int d = 0; d < 3; ++d) {
+        double extent = points.box_max()[d] - points.box_min()[d] + 2.0 * pad;
+        blocks[d] = std::max<int64_t>(1, int64_t(std::ceil(extent / (h * B))));
+        cubes[d] = blocks[d] * B;
+    }
+    mark_band(points, reach, min_reach);
+    sign_far_regions(winding);
+}
+
+Eigen::AlignedBox3d BlockGrid::block_box(int64_t id) const {
+    int64_t p[3];
+    block_position(id, p);
+    Eigen::Vector3d lo = corner(p[0] * B, p[1] * B, p[2] * B);
+    return Eigen::AlignedBox3d(lo, lo + Eigen::Vector3d::Constant(B * h));
+}
+
+void BlockGrid::mark_band(const PointSet &points, const std::vector<float> &reach, double min_reach) {
+    band.assign(size_t(blocks[0] * blocks[1] * blocks[2]), 0);
+    const double block = B * h;
+    for (size_t i = 0; i < points.size(); ++i) {
+        const double r = std::max(double(reach[i]), min_reach);
+        const Eigen::Vector3d p = points.point(i) - origin;
+        int64_t lo[3], hi[3];
+        for (int d = 0; d < 3; ++d) {
+            // Closed boxes, widened a hair: a corner exactly on a block face within reach
+            // marks the blocks on both sides, so no trusted corner is ever forced.
+            lo[d] = std::clamp<int64_t>(int64_t(std::floor((p[d] - r) / block - 1e-9)), 0, blocks[d] - 1);
+            hi[d] = std::clamp<int64_t>(int64_t(std::floor((p[d] + r) / block + 1e-9)), 0, blocks[d] - 1);
+        }
+        for (int64_t z = lo[2]; z <= hi[2]; ++z)
+            for (int64_t y = lo[1]; y <= hi[1]; ++y)
+                for (int64_t x = lo[0]; x <= hi[0]; ++x) band[size_t(block_id(x, y, z))] = 1;
+    }
+}
+
+void BlockGrid::sign_far_regions(const WindingField &winding) {
+    const int64_t nb = int64_t(band.size());
+    std::vector<int32_t> region(size_t(nb), -1);
+    std::vector<int8_t> region_sign;
+    std::vector<int64_t> stack;
+    const int64_t step[3] = {1, blocks[0], blocks[0] * blocks[1]};
+    for (int64_t s = 0; s < nb; ++s) {
+        if (band[size_t(s)] || region[size_t(s)] >= 0) continue;
+        // Block 0 is at the grid's corner, outside the band: region 0 is outside.
+        const int32_t id = int32_t(region_sign.size());
+        region_sign.push_back(id > 0 && winding.winding(block_box(s).center()) > 0.5 ? 1 : -1);
+        region[size_t(s)] = id;
+        stack.push_back(s);
+        while (!stack.empty()) {
+            const int64_t b = stack.back();
+            stack.pop_back();
+            int64_t pos[3];
+            block_position(b, pos);
+            for (int d = 0; d < 3; ++d)
+                for (int side = -1; side <= 1; side += 2) {
+                    if (pos[d] + side < 0 || pos[d] + side >= blocks[d]) continue;
+                    const int64_t next = b + side * step[d];
+                    if (band[size_t(next)] || region[size_t(next)] >= 0) continue;
+                    region[size_t(next)] = id;
+                    stack.push_back(next);
+                }
+        }
+    }
+    far_sign.assign(size_t(nb), 0);
+    for (int64_t b = 0; b < nb; ++b)
+        if (!band[size_t(b)]) far_sign[size_t(b)] = region_sign[size_t(region[size_t(b)])];
+}
+
+int8_t BlockGrid::forced_sign(int64_t x, int64_t y, int64_t z) const {
+    int64_t lo[3], hi[3];
+    const int64_t c[3] = {x, y, z};
+    for (int d = 0; d < 3; ++d) {
+        hi[d] = std::min(c[d] / B, blocks[d] - 1);
+        lo[d] = (c[d] % B == 0 && c[d] > 0) ? c[d] / B - 1 : hi[d];
+    }
+    int8_t s = 0;
+    for (int64_t bz = lo[2]; bz <= hi[2]; ++bz)
+        for (int64_t by = lo[1]; by <= hi[1]; ++by)
+            for (int64_t bx = lo[0]; bx <= hi[0]; ++bx) {
+                const int8_t v = far_sign[size_t(block_id(bx, by, bz))];
+                if (v < 0) return -1;  // outside wins a tie: it is never wrong to close a leak
+                if (v > 0) s = 1;
+            }
+    return s;
+}
+
+}  // namespace gmpu

@@ -1,0 +1,59 @@
+// The polygonizer's sparse grid: cubes of size h grouped in blocks of 8³. Only the band —
+// the blocks within reach of some point's trust radius — is ever evaluated. The other
+// blocks form connected far regions, each wholly inside or outside: the one touching the
+// grid's edge is outside; enclosed ones (cavities, the inside of thick parts) ask the
+// winding number once. A corner touching a far block takes its region's sign, so the
+// band's border never changes sign within a region and every surface closes inside it.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "geometry/point_set.hpp"
+#include "implicit/winding_field.hpp"
+
+namespace gmpu {
+
+struct BlockGrid {
+    static constexpr int B = 8;  // cubes per block side
+
+    Eigen::Vector3d origin;
+    double h = 0.0;
+    int64_t cubes[3] = {0, 0, 0};   // per axis, a multiple of B
+    int64_t blocks[3] = {0, 0, 0};  // per axis
+    std::vector<uint8_t> band;      // per block
+    std::vector<int8_t> far_sign;   // per block: 0 in the band, else its region's sign
+
+    // `reach[i]`: how far from point i the band must extend (its trust radius).
+    BlockGrid(const PointSet &points, int resolution, const std::vector<float> &reach, double min_reach,
+              const WindingField &winding);
+
+    Eigen::Vector3d corner(int64_t x, int64_t y, int64_t z) const {
+        return origin + h * Eigen::Vector3d(double(x), double(y), double(z));
+    }
+    uint64_t corner_id(int64_t x, int64_t y, int64_t z) const {
+        return uint64_t(x + (cubes[0] + 1) * (y + (cubes[1] + 1) * z));
+    }
+    int64_t block_id(int64_t x, int64_t y, int64_t z) const { return x + blocks[0] * (y + blocks[1] * z); }
+    void block_position(int64_t id, int64_t pos[3]) const {
+        pos[0] = id % blocks[0];
+        pos[1] = (id / blocks[0]) % blocks[1];
+        pos[2] = id / (blocks[0] * blocks[1]);
+    }
+    Eigen::AlignedBox3d block_box(int64_t id) const;
+
+    // Sign imposed on grid corner (x, y, z) by the far blocks touching it, 0 if none. A
+    // function of the corner alone, so every block sharing it agrees.
+    int8_t forced_sign(int64_t x, int64_t y, int64_t z) const;
+
+    size_t block_count() const { return band.size(); }
+
+private:
+    void mark_band(const PointSet &points, const std::vector<float> &reach, double min_reach);
+    void sign_far_regions(const WindingField &winding);
+};
+
+}  // namespace gmpu
