@@ -1,6 +1,7 @@
 // The triangle mesh that polygonize produces and the C ABI hands out.
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 

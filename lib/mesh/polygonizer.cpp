@@ -8,18 +8,24 @@
 #include "core/parallel.hpp"
 #include "mesh/block_grid.hpp"
 #include "mesh/marching_tetrahedra.hpp"
+#include "mesh/mesh_cleanup.hpp"
 
 namespace gmpu {
 
 namespace {
 
 constexpr int B = BlockGrid::B;
+// A closed piece of surface must be the nearest surface of at least this many input points
+// to be kept: a real part, however small, holds points (local fits need N_min of them);
+// a bubble of the far field or a stray quadric sheet holds none.
+constexpr uint32_t kMinVotes = 3;
 
 struct BlockOutput {
     std::vector<uint64_t> vertex_key;         // grid edge per vertex: corner id × 8 + direction
     std::vector<Eigen::Vector3d> vertex_pos;  // normalised frame
     std::vector<Eigen::Vector3d> vertex_grad;
     std::vector<uint32_t> triangles;          // block-local vertex indices
+    std::vector<uint32_t> votes;              // per vertex: input points in the block nearest to it
 };
 
 // Values at the (B+1)³ corners of one band block. Each corner's value depends on its
@@ -30,18 +36,14 @@ struct BlockOutput {
 //    coarse lattice of every fourth corner and interpolated — its sign only matters away
 //    from the data, where it varies slowly, and this costs 1/64 of the neighbour searches.
 void corner_values(const BlockGrid &g, const SurfaceField &f, const std::vector<uint32_t> &leaves,
-                   const int64_t origin[3], std::vector<double> &value) {
+                   const std::vector<uint32_t> &near, const int64_t origin[3], std::vector<double> &value) {
     constexpr int C = B + 1, S = 4, CC = B / S + 1;  // coarse lattice step and size
     auto local = [](int i, int j, int k) { return i + C * (j + C * k); };
 
     // Trust by splatting every nearby point's ball onto the corners.
     thread_local std::vector<uint8_t> trusted(C * C * C);
-    thread_local std::vector<uint32_t> near;
     std::fill(trusted.begin(), trusted.end(), 0);
     const Eigen::Vector3d lo = g.corner(origin[0], origin[1], origin[2]);
-    const Eigen::Vector3d centre = lo + Eigen::Vector3d::Constant(0.5 * B * g.h);
-    near.clear();
-    f.points().within(centre, 0.5 * std::sqrt(3.0) * B * g.h + f.widest_trust() * (1.0 + 1e-5) + 1e-7, near);
     for (uint32_t p : near) {
         const Eigen::Vector3d q = f.points().point(p);
         const double r = f.trust_radius(p);
@@ -108,7 +110,12 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, int64_t block, 
     const int64_t x0 = pos[0] * B, y0 = pos[1] * B, z0 = pos[2] * B;
     const int64_t origin[3] = {x0, y0, z0};
     auto local = [](int i, int j, int k) { return i + C * (j + C * k); };
-    corner_values(g, f, leaves, origin, value);
+    // Every point whose trust ball may reach the block.
+    thread_local std::vector<uint32_t> near;
+    near.clear();
+    const Eigen::AlignedBox3d box = g.block_box(block);
+    f.points().within(box.center(), 0.5 * std::sqrt(3.0) * B * g.h + f.widest_trust() * (1.0 + 1e-5) + 1e-7, near);
+    corner_values(g, f, leaves, near, origin, value);
     std::fill(slot.begin(), slot.end(), -1);
 
     auto vertex = [&](int i, int j, int k, const mt::Edge &e) -> uint32_t {
@@ -146,10 +153,28 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, int64_t block, 
                         for (int v = 0; v < 3; ++v) out.triangles.push_back(vertex(i, j, k, tc.triangles[tri][v]));
                 }
             }
+
+    // Each point inside the block votes for its nearest vertex here: the surface near the
+    // data collects the votes, bubbles away from it none (see remove_unsupported_components).
+    out.votes.assign(out.vertex_pos.size(), 0);
+    if (out.vertex_pos.empty()) return;
+    for (uint32_t p : near) {
+        const Eigen::Vector3d q = f.points().point(p);
+        if (!(q.array() >= box.min().array()).all() || !(q.array() < box.max().array()).all()) continue;
+        size_t best = 0;
+        double best_d2 = INFINITY;
+        for (size_t v = 0; v < out.vertex_pos.size(); ++v) {
+            const double d2 = (out.vertex_pos[v] - q).squaredNorm();
+            if (d2 < best_d2) best_d2 = d2, best = v;
+        }
+        ++out.votes[best];
+    }
 }
 
 // One vertex per grid edge across blocks: sort every block's vertices by edge key.
-Mesh weld(std::vector<BlockOutput> &blocks, const Normalisation &norm, Progress &progress) {
+// `votes` receives the point votes per welded vertex.
+Mesh weld(std::vector<BlockOutput> &blocks, const Normalisation &norm, Progress &progress,
+          std::vector<uint32_t> &votes) {
     std::vector<std::pair<uint64_t, uint64_t>> keyed;  // (edge key, block << 32 | local index)
     for (size_t b = 0; b < blocks.size(); ++b)
         for (size_t v = 0; v < blocks[b].vertex_key.size(); ++v) keyed.push_back({blocks[b].vertex_key[v], uint64_t(b) << 32 | v});
@@ -168,8 +193,10 @@ Mesh weld(std::vector<BlockOutput> &blocks, const Normalisation &norm, Progress 
             if (!n.allFinite()) n = Eigen::Vector3d::UnitZ();
             mesh.vertices.insert(mesh.vertices.end(), {p[0], p[1], p[2]});
             mesh.normals.insert(mesh.normals.end(), {n[0], n[1], n[2]});
+            votes.push_back(0);
         }
         remap[b][v] = uint32_t(mesh.vertex_count() - 1);
+        votes.back() += blocks[b].votes[v];
     }
     for (size_t b = 0; b < blocks.size(); ++b)
         for (uint32_t v : blocks[b].triangles) mesh.triangles.push_back(remap[b][v]);
@@ -218,7 +245,10 @@ Mesh polygonize(const MpuFunction &mpu, const WindingField &winding, const Point
     }, 0.02 * total, total, 4);
     progress.throw_if_cancelled();
     progress.report(0.95);
-    Mesh mesh = weld(blocks, points.normalisation(), progress);
+    std::vector<uint32_t> votes;
+    Mesh mesh = weld(blocks, points.normalisation(), progress, votes);
+    progress.throw_if_cancelled();
+    remove_unsupported_components(mesh, votes, kMinVotes);
     progress.report(1.0, true);
     return mesh;
 }

@@ -1,0 +1,19 @@
+// Removing whole closed components keeps a watertight mesh watertight: the one clean-up
+// the polygonizer does.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "mesh/mesh.hpp"
+
+namespace gmpu {
+
+// Connected component (by shared vertices) of every vertex; returns the count.
+uint32_t vertex_components(const Mesh &mesh, std::vector<uint32_t> &component);
+
+// Drops every connected component whose vertices received fewer than `min_votes` votes
+// in total (votes: one count per vertex), and compacts the vertex arrays.
+void remove_unsupported_components(Mesh &mesh, const std::vector<uint32_t> &votes, uint32_t min_votes);
+
+}  // namespace gmpu
