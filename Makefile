@@ -58,6 +58,9 @@ test-c: build
 test-python: build
 
 test-node: build
+	cd bindings/node && npm ci --no-audit --no-fund --loglevel=error
+	cd examples/node && npm ci --no-audit --no-fund --loglevel=error
+	node --test tests/node/
 
 test-rust: build
 

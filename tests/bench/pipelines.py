@@ -166,8 +166,10 @@ class Cgal(Pipeline):
             return ""
         self.exe.parent.mkdir(parents=True, exist_ok=True)
         print(f"compiling {self.exe} (CGAL is header-only: about a minute)", flush=True)
+        # g++'s temporary files go beside the output: a shared /tmp may be emptied meanwhile.
         built = subprocess.run(["g++", *self.FLAGS, str(self.SOURCE), "-o", str(self.exe),
-                                "-lgmp", "-lmpfr"], capture_output=True, text=True)
+                                "-lgmp", "-lmpfr"], capture_output=True, text=True,
+                               env={**os.environ, "TMPDIR": str(self.exe.parent)})
         return "" if built.returncode == 0 else "cgal_peer does not compile:\n" + built.stderr[-2000:]
 
     def command(self, cloud, mesh, points):

@@ -274,6 +274,16 @@ def render_models(rows, out_dir):
     return written
 
 
+def load_note(rows):
+    """Times are only comparable on a quiet machine: say so when this one was not."""
+    loads = [r["load_before"] for r in rows if "load_before" in r]
+    if not loads or statistics.fmean(loads) < 1.0:
+        return ""
+    return (f" **The machine was shared with other work during this run** (1-minute load "
+            f"average before each run: mean {statistics.fmean(loads):.1f}, max {max(loads):.1f}, "
+            "on 2 cores): times are longer and noisier than on an idle machine.")
+
+
 # ---- everything ----
 
 def write_all(results, out_dir, renders=True):
@@ -287,12 +297,13 @@ def write_all(results, out_dir, renders=True):
     m = results["machine"]
     machine = (f"{m['cpu']}, {m['cores']} cores, {m['memory_gb']} GB, {m['os']}; run {m['date']}")
     summary = (
+        "## Benchmark: gmpu beside Open3D and CGAL\n\n"
         f"Measured on {machine}. Every number below comes from one run of `make bench`, gmpu "
         "and the peers side by side; distances are exact point-to-triangle, relative to the "
         "ground truth's bounding-box diagonal, 100k samples per surface; orientation is the "
         "share of input points whose output normal points outward (no global flip allowed). "
         "Time is normals + orientation + surface (no file I/O, no interpreter start-up); wall "
-        "and peak memory are the whole child process.\n\n"
+        "and peak memory are the whole child process." + load_note(rows + scale) + "\n\n"
         "### Targets (issue 5)\n\n" + targets(results) + "\n"
         "### Over all clouds\n\n" + summary_table(rows) + "\n"
         "### Scale series\n\n" + scale_table(scale) + "\n"
@@ -302,7 +313,7 @@ def write_all(results, out_dir, renders=True):
         + "### Pictures (red: a surface seen from inside, i.e. inside-out)\n\n"
         + "".join(f"[{p.stem}](renders/{p.name}) " for p in pictures) + "\n")
     (out_dir / "summary.md").write_text(summary)
-    full = ("# gmpu benchmark results\n\n" + summary +
+    full = (summary +
             "\n## Every run\n\n" + results_table(rows) +
             "\n## Ratios gmpu / peer, same run\n\n" + ratio_table(rows))
     (out_dir / "results.md").write_text(full)

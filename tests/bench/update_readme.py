@@ -4,9 +4,10 @@
     update_readme.py [RESULTS_DIR] [--readme README.md] [--assets docs/bench]
 
 Replaces what lies between the `<!-- bench:begin -->` and `<!-- bench:end -->` lines of
-the README with RESULTS_DIR/summary.md, and copies the plots and renders it links to into
-the assets folder (bench-results/ itself is not committed). Exits 1 when the README has
-no such markers, so that a section is never silently left stale.
+the README (or, failing those, `<!-- results:begin -->` / `<!-- results:end -->`) with
+RESULTS_DIR/summary.md, and copies the plots and renders it links to into the assets
+folder (bench-results/ itself is not committed). Exits 1 when the README has no such
+markers, so that a section is never silently left stale.
 """
 import argparse
 import re
@@ -15,7 +16,8 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-BEGIN, END = "<!-- bench:begin -->", "<!-- bench:end -->"
+MARKERS = [("<!-- bench:begin -->", "<!-- bench:end -->"),
+           ("<!-- results:begin -->", "<!-- results:end -->")]
 
 
 def main():
@@ -32,9 +34,12 @@ def main():
     if not args.readme.exists():
         sys.exit(f"update_readme: {args.readme} does not exist")
     readme = args.readme.read_text()
-    if readme.count(BEGIN) != 1 or readme.count(END) != 1 or readme.index(BEGIN) > readme.index(END):
-        sys.exit(f"update_readme: {args.readme} needs one '{BEGIN}' line and, after it, one "
-                 f"'{END}' line around the benchmark section")
+    pair = next(((b, e) for b, e in MARKERS if readme.count(b) == 1 and readme.count(e) == 1
+                 and readme.index(b) < readme.index(e)), None)
+    if pair is None:
+        sys.exit(f"update_readme: {args.readme} needs one '{MARKERS[0][0]}' line and, after it, "
+                 f"one '{MARKERS[0][1]}' line around the benchmark section")
+    begin, end = pair
 
     summary = summary_path.read_text()
     # Copy every linked PNG and point the link at the copy, relative to the README.
@@ -51,9 +56,9 @@ def main():
         return f"{match.group(1)}({(prefix / target).as_posix()})"
 
     summary = re.sub(r"(\]\s*)\(([^)\s]+\.png)\)", relink, summary)
-    head, rest = readme.split(BEGIN, 1)
-    _, tail = rest.split(END, 1)
-    args.readme.write_text(f"{head}{BEGIN}\n{summary.rstrip()}\n{END}{tail}")
+    head, rest = readme.split(begin, 1)
+    _, tail = rest.split(end, 1)
+    args.readme.write_text(f"{head}{begin}\n{summary.rstrip()}\n{end}{tail}")
     print(f"update_readme: {args.readme} benchmark section regenerated from {summary_path}")
 
 

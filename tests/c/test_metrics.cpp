@@ -200,6 +200,24 @@ void icosphere_is_within_its_sagitta_of_the_sphere(void **) {
     }
 }
 
+void icosphere_against_the_analytic_sphere(void **) {
+    // Both ways within the sagitta, wound outward; reversed, every sample faces inward.
+    const TriangleMesh mesh = icosphere(4, 2.0, Vec3(1, 0, 0));
+    const Sphere sphere(Vec3(1, 0, 0), 2.0);
+    const double sagitta = 2.0 * 1.6e-3;  // < 1.6e-3 for the unit sphere (test above)
+    const ShapeDeviation d = compare_to_shape(mesh, sphere);
+    assert_true(d.max_distance <= sagitta && d.max_gap <= sagitta);
+    assert_true(d.mean_distance > 0.1 * sagitta && d.mean_gap > 0.1 * sagitta);
+    assert_true(d.normal_agreement > 0.999 && d.inward_share == 0);
+    const ShapeDeviation f = compare_to_shape(flipped(mesh), sphere);
+    assert_true(f.normal_agreement < -0.999 && f.inward_share == 1);
+    // A hole shows as a gap even though every mesh point is on the sphere.
+    TriangleMesh holed = mesh;
+    holed.triangles.resize(holed.triangles.size() / 2);
+    assert_true(compare_to_shape(holed, sphere).max_gap > 0.5);
+    assert_true(std::isinf(compare_to_shape(TriangleMesh{}, sphere).max_gap));
+}
+
 void mesh_against_itself_scores_perfectly(void **) {
     const TriangleMesh mesh = torus_mesh(1, 0.3, 48, 20);
     const SurfaceComparison r = compare_surfaces(mesh, mesh, {20000, 1, {0.005, 0.01}, 0});
@@ -544,6 +562,7 @@ int main(void) {
         cmocka_unit_test(tree_skips_zero_area_and_handles_empty),
         cmocka_unit_test(tree_answers_100k_queries_on_100k_triangles_fast),
         cmocka_unit_test(icosphere_is_within_its_sagitta_of_the_sphere),
+        cmocka_unit_test(icosphere_against_the_analytic_sphere),
         cmocka_unit_test(mesh_against_itself_scores_perfectly),
         cmocka_unit_test(translated_copy_measures_the_translation),
         cmocka_unit_test(tilted_square_has_known_distance_distribution),

@@ -104,4 +104,38 @@ OrientationScore orientation_accuracy(const std::vector<Vec3> &normals,
     return s;
 }
 
+ShapeDeviation compare_to_shape(const TriangleMesh &mesh, const AnalyticShape &shape,
+                                size_t samples, uint64_t seed) {
+    ShapeDeviation d;
+    if (!(surface_area(mesh) > 0) || samples == 0) {
+        d.mean_distance = d.max_distance = d.mean_gap = d.max_gap =
+            std::numeric_limits<double>::infinity();
+        d.normal_agreement = d.inward_share = std::numeric_limits<double>::quiet_NaN();
+        return d;
+    }
+    const MeshSamples on_mesh = sample_mesh(mesh, samples, seed);
+    size_t inward = 0;
+    for (size_t i = 0; i < on_mesh.size(); ++i) {
+        const double distance = std::abs(shape.signed_distance(on_mesh.positions[i]));
+        d.mean_distance += distance;
+        d.max_distance = std::max(d.max_distance, distance);
+        const double cosine = on_mesh.normals[i].dot(shape.normal(on_mesh.positions[i]));
+        d.normal_agreement += cosine;
+        inward += cosine < 0;
+    }
+    const auto n = static_cast<double>(on_mesh.size());
+    d.mean_distance /= n;
+    d.normal_agreement /= n;
+    d.inward_share = static_cast<double>(inward) / n;
+
+    const AabbTree tree(mesh);
+    const OrientedPoints on_shape = shape.sample(samples, seed + 1);
+    for (const AabbTree::Nearest &hit : tree.nearest_all(on_shape.positions)) {
+        d.mean_gap += hit.distance;
+        d.max_gap = std::max(d.max_gap, hit.distance);
+    }
+    d.mean_gap /= static_cast<double>(on_shape.size());
+    return d;
+}
+
 }  // namespace gmpu::testing

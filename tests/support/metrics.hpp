@@ -3,6 +3,7 @@
 // ground truth's bounding-box diagonal.
 #pragma once
 
+#include "analytic_shapes.hpp"
 #include "triangle_mesh.hpp"
 
 #include <cstdint>
@@ -59,5 +60,20 @@ struct OrientationScore {
 // sizes differ.
 OrientationScore orientation_accuracy(const std::vector<Vec3> &normals,
                                       const std::vector<Vec3> &gt_normals);
+
+// A mesh against a solid known in closed form (for tests on analytic shapes). Distances
+// are absolute (the caller knows the shape's size).
+struct ShapeDeviation {
+    double mean_distance = 0, max_distance = 0;  // mesh samples → shape boundary (|SDF|)
+    double mean_gap = 0, max_gap = 0;            // shape samples → mesh (holes, missing parts)
+    // Mean cosine between each mesh sample's triangle normal and the shape's outward
+    // normal there: 1 when wound outward, −1 inside-out.
+    double normal_agreement = 0;
+    double inward_share = 0;  // share of mesh samples whose triangle faces inward
+};
+
+// An empty mesh gets infinite distances and gaps and NaN agreement.
+ShapeDeviation compare_to_shape(const TriangleMesh &mesh, const AnalyticShape &shape,
+                                size_t samples = 20000, uint64_t seed = 1);
 
 }  // namespace gmpu::testing

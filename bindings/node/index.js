@@ -1,0 +1,589 @@
+// gmpu for Node.js: unoriented point cloud in, oriented implicit surface and watertight
+// mesh out. A thin layer over the C ABI (include/gmpu/gmpu.h) through koffi; see index.d.ts
+// for the documented API.
+import { fileURLToPath } from 'node:url';
+import { getNative, copyArray, koffi, LibraryError } from './lib/native.js';
+
+// ---- errors ----------------------------------------------------------------------------
+
+/** gmpu_status values by name (fixed forever by the C ABI). */
+export const Status = Object.freeze({
+    GMPU_OK: 0,
+    GMPU_ERROR_INVALID_ARGUMENT: 1,
+    GMPU_ERROR_INVALID_INPUT: 2,
+    GMPU_ERROR_DEGENERATE_INPUT: 3,
+    GMPU_ERROR_WRONG_ORDER: 4,
+    GMPU_ERROR_OUT_OF_MEMORY: 5,
+    GMPU_ERROR_LIMIT_EXCEEDED: 6,
+    GMPU_ERROR_CANCELLED: 7,
+    GMPU_ERROR_IO: 8,
+    GMPU_ERROR_PARSE: 9,
+    GMPU_ERROR_UNSUPPORTED: 10,
+    GMPU_ERROR_INTERNAL: 11,
+});
+const statusNames = Object.fromEntries(Object.entries(Status).map(([k, v]) => [v, k]));
+
+/** Every failure of this package: `code` is the C status name, `message` the C message. */
+export class GmpuError extends Error {
+    constructor(code, message, options) {
+        super(message, options);
+        this.name = 'GmpuError';
+        this.code = code;
+        this.status = Object.hasOwn(Status, code) ? Status[code] : undefined;
+    }
+}
+
+// A failure detected on the JS side, worded like the C library's messages.
+function jsError(code, text) {
+    return new GmpuError(code, `${code}: ${text}`);
+}
+const invalidArgument = (text) => jsError('GMPU_ERROR_INVALID_ARGUMENT', text);
+
+function lib() {
+    try {
+        return getNative();
+    } catch (err) {
+        if (err instanceof LibraryError) throw new GmpuError(err.code, err.message);
+        throw err;
+    }
+}
+
+// The error of a failed call: status name and message from the library. Every call here
+// runs on the JS thread, so gmpu_last_error() (thread-local, any function) is the message
+// of this failure. gmpu_surface_last_error(handle) is only a fallback: const calls
+// (evaluate, copy_normals, get_param, get_stat) do not set it, so it may hold an older one.
+function failure(status, handle) {
+    const n = lib();
+    const code = statusNames[status] ?? n.status_name(status);
+    const message = n.last_error() || (handle ? n.surface_last_error(handle) : '') || code;
+    return new GmpuError(code, message);
+}
+
+function check(status, handle) {
+    if (status !== 0) throw failure(status, handle);
+}
+
+// ---- parameters, stages, statistics ----------------------------------------------------
+
+const PARAMS = Object.freeze({
+    error: 1,
+    maxDepth: 2,
+    minPoints: 3,
+    supportScale: 4,
+    sharpFeatures: 5,
+    resolution: 6,
+    level: 7,
+    threads: 8,
+    maxCells: 9,
+    maxTriangles: 10,
+    noiseScale: 11,
+});
+
+const STATS = Object.freeze({
+    points: 1,
+    cells: 2,
+    leaves: 3,
+    depth: 4,
+    quadricCells: 5,
+    bivariateCells: 6,
+    piecewiseCells: 7,
+    components: 8,
+    flippedCells: 9,
+    fitSeconds: 10,
+    orientSeconds: 11,
+    polygonizeSeconds: 12,
+    resolution: 13,
+    bboxDiagonal: 14,
+    noise: 15,
+    effectiveError: 16,
+});
+
+const STAGES = Object.freeze({ 1: 'fit', 2: 'orient', 3: 'polygonize' });
+
+/** Names of the parameters (Surface options) and statistics. */
+export const parameterNames = Object.freeze(Object.keys(PARAMS));
+export const statisticNames = Object.freeze(Object.keys(STATS));
+
+function paramKey(name) {
+    if (!Object.hasOwn(PARAMS, name))
+        throw invalidArgument(`unknown parameter '${String(name)}' (one of: ${parameterNames.join(', ')})`);
+    return PARAMS[name];
+}
+
+function paramValue(name, value) {
+    if (typeof value === 'boolean') return value ? 1 : 0;
+    if (typeof value !== 'number')
+        throw invalidArgument(`parameter '${name}' must be a number, got ${typeof value}`);
+    return value;
+}
+
+// ---- input conversion ------------------------------------------------------------------
+
+function describe(value) {
+    if (value === null) return 'null';
+    if (ArrayBuffer.isView(value)) return value.constructor.name;
+    if (Array.isArray(value)) return 'Array';
+    return typeof value;
+}
+
+// points → { data: Float64Array | Float32Array, count }. Typed arrays are used as they
+// are (no copy); an array of [x, y, z] triples is packed into a Float64Array.
+function toXyz(points, what, { allowF32 = true } = {}) {
+    if (points instanceof Float64Array || points instanceof Float32Array) {
+        if (points.length % 3 !== 0)
+            throw invalidArgument(`${what}: length ${points.length} is not a multiple of 3 (x y z per point)`);
+        const data = !allowF32 && points instanceof Float32Array ? Float64Array.from(points) : points;
+        return { data, count: points.length / 3 };
+    }
+    if (Array.isArray(points)) {
+        const out = new Float64Array(3 * points.length);
+        for (let i = 0; i < points.length; ++i) {
+            const p = points[i];
+            if (p === null || typeof p !== 'object' || p.length !== 3)
+                throw invalidArgument(`${what}[${i}] is not an [x, y, z] triple`);
+            for (let k = 0; k < 3; ++k) {
+                const v = p[k];
+                if (typeof v !== 'number') throw invalidArgument(`${what}[${i}][${k}] is not a number`);
+                out[3 * i + k] = v;
+            }
+        }
+        return { data: out, count: points.length };
+    }
+    throw invalidArgument(
+        `${what} must be a Float32Array or Float64Array of x y z triples, or an array of [x, y, z]; got ${describe(points)}`,
+    );
+}
+
+// faces → Uint32Array (flat, 3 per triangle). Accepts any typed or plain array of
+// integers, flat or as [a, b, c] triples.
+function toFaces(faces, what) {
+    if (faces instanceof Uint32Array) {
+        if (faces.length % 3 !== 0) throw invalidArgument(`${what}: length ${faces.length} is not a multiple of 3`);
+        return faces;
+    }
+    let flat;
+    if (Array.isArray(faces) && faces.length > 0 && typeof faces[0] === 'object' && faces[0] !== null) {
+        flat = [];
+        faces.forEach((t, i) => {
+            if (t === null || typeof t !== 'object' || t.length !== 3) throw invalidArgument(`${what}[${i}] is not an [a, b, c] triple`);
+            flat.push(t[0], t[1], t[2]);
+        });
+    } else if (Array.isArray(faces) || ArrayBuffer.isView(faces)) {
+        flat = faces;
+    } else {
+        throw invalidArgument(`${what} must be a Uint32Array or an array of vertex indices; got ${describe(faces)}`);
+    }
+    if (flat.length % 3 !== 0) throw invalidArgument(`${what}: length ${flat.length} is not a multiple of 3`);
+    const out = new Uint32Array(flat.length);
+    for (let i = 0; i < flat.length; ++i) {
+        const v = Number(flat[i]);
+        if (!Number.isInteger(v) || v < 0 || v > 0xffffffff)
+            throw jsError('GMPU_ERROR_INVALID_INPUT', `${what}: triangle ${Math.floor(i / 3)} has an invalid vertex index ${flat[i]}`);
+        out[i] = v;
+    }
+    return out;
+}
+
+// What setPoints accepts besides coordinates: a PointCloud from readPoints, or a file.
+function isPointSource(v) {
+    return ArrayBuffer.isView(v) || Array.isArray(v) || typeof v === 'string' || v instanceof URL ||
+        (v !== null && typeof v === 'object' && 'positions' in v);
+}
+
+function pointSource(points) {
+    if (typeof points === 'string' || points instanceof URL) return readPoints(points).positions;
+    if (points !== null && typeof points === 'object' && !Array.isArray(points) && !ArrayBuffer.isView(points) && 'positions' in points)
+        return points.positions;
+    return points;
+}
+
+function toPath(p, what = 'path') {
+    if (p instanceof URL) p = fileURLToPath(p);
+    if (typeof p !== 'string' || p.length === 0) throw invalidArgument(`${what} must be a non-empty string or a file: URL`);
+    // koffi would silently cut the string at a NUL byte.
+    if (p.includes('\0')) throw invalidArgument(`${what} contains a NUL character`);
+    return p;
+}
+
+// A non-NULL pointer for empty input, so that the C library reports "too few points"
+// (INVALID_INPUT) rather than "xyz is NULL" for an empty array.
+const EMPTY_F64 = new Float64Array(3);
+const EMPTY_F32 = new Float32Array(3);
+const nonEmpty = (data) => (data.length > 0 ? data : data instanceof Float32Array ? EMPTY_F32 : EMPTY_F64);
+
+// ---- surface ---------------------------------------------------------------------------
+
+// Safety net only: a Surface that was never closed frees its handle when collected.
+const finalizer = new FinalizationRegistry((cell) => {
+    if (cell.ptr !== null) {
+        const ptr = cell.ptr;
+        cell.ptr = null;
+        getNative().surface_destroy(ptr);
+    }
+});
+
+/**
+ * A reconstruction: points → fit → orient → evaluate / normals / polygonize.
+ * Owns a native handle: call close() when done (it is idempotent).
+ */
+export class Surface {
+    #cell; // { ptr } shared with the finalizer
+    #busy = false; // inside fit / orient / polygonize (the progress callback may run)
+    #closeRequested = false;
+
+    /** @type {((stage: string, fraction: number) => unknown) | null} */
+    onProgress = null;
+
+    /**
+     * new Surface([points], [options]): options are parameters, `onProgress` and `normals`
+     * (known outward normals for the points); points as for setPoints.
+     */
+    constructor(pointsOrOptions, options) {
+        let points;
+        if (pointsOrOptions === undefined || pointsOrOptions === null) {
+            // new Surface() or new Surface(undefined, options)
+        } else if (isPointSource(pointsOrOptions)) {
+            points = pointsOrOptions;
+        } else if (options === undefined) {
+            options = pointsOrOptions;
+        } else {
+            throw invalidArgument(`points must be point coordinates, a PointCloud or a path; got ${describe(pointsOrOptions)}`);
+        }
+        options ??= {};
+        if (typeof options !== 'object') throw invalidArgument('options must be an object');
+        const n = lib();
+        const out = [null];
+        check(n.surface_create(out));
+        this.#cell = { ptr: out[0] };
+        finalizer.register(this, this.#cell, this.#cell);
+        try {
+            applyOptions(this, options, ['normals']);
+            if (points !== undefined) this.setPoints(points);
+            if (options.normals !== undefined && options.normals !== null) {
+                if (points === undefined) throw jsError('GMPU_ERROR_WRONG_ORDER', 'normals given without points');
+                this.setNormals(options.normals);
+            }
+        } catch (err) {
+            this.close();
+            throw err;
+        }
+    }
+
+    /** True once close() has run. */
+    get closed() {
+        return this.#cell.ptr === null;
+    }
+
+    // The live handle, or an error if closed or re-entered from the progress callback.
+    #handle() {
+        if (this.#cell.ptr === null) throw invalidArgument('the Surface is closed');
+        if (this.#busy)
+            throw jsError('GMPU_ERROR_WRONG_ORDER', 'the Surface is busy: it cannot be used from its own progress callback');
+        return this.#cell.ptr;
+    }
+
+    /** Frees the native surface. Idempotent. Inside onProgress, cancels the running stage and frees it afterwards. */
+    close() {
+        if (this.#cell.ptr === null) return;
+        if (this.#busy) {
+            this.#closeRequested = true;
+            return;
+        }
+        const ptr = this.#cell.ptr;
+        this.#cell.ptr = null;
+        finalizer.unregister(this.#cell);
+        lib().surface_destroy(ptr);
+    }
+
+    setParam(name, value) {
+        const h = this.#handle();
+        check(lib().surface_set_param(h, paramKey(name), paramValue(name, value)), h);
+        return this;
+    }
+
+    getParam(name) {
+        const h = this.#handle();
+        const out = [0];
+        check(lib().surface_get_param(h, paramKey(name), out));
+        return out[0];
+    }
+
+    stat(name) {
+        const h = this.#handle();
+        if (!Object.hasOwn(STATS, name))
+            throw invalidArgument(`unknown statistic '${String(name)}' (one of: ${statisticNames.join(', ')})`);
+        const out = [0];
+        check(lib().surface_get_stat(h, STATS[name], out));
+        return out[0];
+    }
+
+    /** Sets several parameters: { name: value }. */
+    setParams(params) {
+        if (params === null || typeof params !== 'object') throw invalidArgument('params must be an object');
+        for (const [name, value] of Object.entries(params)) if (value !== undefined) this.setParam(name, value);
+        return this;
+    }
+
+    /** Every parameter, by name. */
+    params() {
+        return Object.fromEntries(parameterNames.map((name) => [name, this.getParam(name)]));
+    }
+
+    /** Every statistic, by name. */
+    stats() {
+        return Object.fromEntries(statisticNames.map((name) => [name, this.stat(name)]));
+    }
+
+    get pointCount() {
+        return Number(lib().surface_point_count(this.#handle()));
+    }
+
+    setPoints(points) {
+        const h = this.#handle();
+        const { data, count } = toXyz(pointSource(points), 'points');
+        const n = lib();
+        const fn = data instanceof Float32Array ? n.surface_set_points_f32 : n.surface_set_points_f64;
+        check(fn(h, nonEmpty(data), count, 0), h);
+        return this;
+    }
+
+    setNormals(normals) {
+        const h = this.#handle();
+        const { data, count } = toXyz(normals, 'normals');
+        const n = lib();
+        const fn = data instanceof Float32Array ? n.surface_set_normals_f32 : n.surface_set_normals_f64;
+        check(fn(h, nonEmpty(data), count, 0), h);
+        return this;
+    }
+
+    /** Builds the octree of local fits; with `points`, sets them first. */
+    fit(points) {
+        if (points !== undefined && points !== null) this.setPoints(points);
+        this.#stage((h) => lib().surface_fit(h));
+        return this;
+    }
+
+    orient() {
+        this.#stage((h) => lib().surface_orient(h));
+        return this;
+    }
+
+    evaluate(points, options = {}) {
+        const h = this.#handle();
+        const { data, count } = toXyz(points, 'points', { allowF32: false });
+        const values = new Float64Array(count);
+        const gradients = options?.gradient ? new Float64Array(3 * count) : null;
+        if (count > 0) check(lib().surface_evaluate(h, data, count, values, gradients));
+        else check(lib().surface_evaluate(h, EMPTY_F64, 0, EMPTY_F64, null));
+        return gradients !== null ? { values, gradients } : values;
+    }
+
+    /** ∇f at each point (3 per point): it points into the solid. */
+    gradient(points) {
+        return this.evaluate(points, { gradient: true }).gradients;
+    }
+
+    /** Oriented unit normal of every input point: Float64Array, 3 per point. */
+    normals() {
+        const h = this.#handle();
+        const n = lib();
+        const count = Number(n.surface_point_count(h));
+        const out = new Float64Array(3 * count);
+        check(n.surface_copy_normals(h, count > 0 ? out : EMPTY_F64, count));
+        return out;
+    }
+
+    /**
+     * The zero set as a closed mesh: { vertices, faces, normals }. `resolution` and `level`
+     * apply to this call only (the surface's parameters are restored afterwards).
+     */
+    polygonize(options = {}) {
+        const overrides = Object.entries(options ?? {}).filter(([, v]) => v !== undefined);
+        for (const [name] of overrides)
+            if (name !== 'resolution' && name !== 'level')
+                throw invalidArgument(`unknown polygonize option '${name}' (options: resolution, level)`);
+        const saved = overrides.map(([name]) => [name, this.getParam(name)]);
+        const out = [null];
+        try {
+            for (const [name, value] of overrides) this.setParam(name, value);
+            this.#stage((h) => lib().surface_polygonize(h, out));
+        } finally {
+            if (!this.closed) for (const [name, value] of saved) this.setParam(name, value);
+        }
+        return takeMesh(out[0]);
+    }
+
+    // Runs one stage with the progress callback registered for its duration only.
+    #stage(call) {
+        const h = this.#handle();
+        const n = lib();
+        const user = this.onProgress;
+        if (user !== null && user !== undefined && typeof user !== 'function')
+            throw invalidArgument('onProgress must be a function');
+        let thrown = null;
+        let callback = null;
+        if (user) {
+            callback = koffi.register((_user, stage, fraction) => {
+                if (thrown !== null || this.#closeRequested) return 1;
+                try {
+                    const result = user(STAGES[stage] ?? String(stage), fraction);
+                    return result === false || this.#closeRequested ? 1 : 0;
+                } catch (err) {
+                    thrown = { err };
+                    return 1;
+                }
+            }, n.progressType);
+        }
+        let error = null;
+        try {
+            if (callback !== null) check(n.surface_set_progress(h, callback, null), h);
+            this.#busy = true;
+            try {
+                const status = call(h);
+                if (status !== 0) error = failure(status, h); // before any other gmpu call
+            } finally {
+                this.#busy = false;
+            }
+        } finally {
+            if (callback !== null) {
+                n.surface_set_progress(h, null, null);
+                koffi.unregister(callback);
+            }
+        }
+        if (this.#closeRequested) {
+            this.#closeRequested = false;
+            this.close();
+        }
+        if (thrown !== null) throw thrown.err;
+        if (error !== null) throw error;
+    }
+}
+
+if (typeof Symbol.dispose === 'symbol') {
+    Surface.prototype[Symbol.dispose] = function dispose() {
+        this.close();
+    };
+}
+
+function applyOptions(surface, options, extra) {
+    if (options === null || typeof options !== 'object') throw invalidArgument('options must be an object');
+    for (const [key, value] of Object.entries(options)) {
+        if (value === undefined || extra.includes(key)) continue;
+        if (key === 'onProgress') {
+            if (value !== null && typeof value !== 'function') throw invalidArgument('onProgress must be a function');
+            surface.onProgress = value;
+        } else if (Object.hasOwn(PARAMS, key)) {
+            surface.setParam(key, value);
+        } else {
+            throw invalidArgument(`unknown option '${key}' (options: ${[...parameterNames, 'onProgress', ...extra].join(', ')})`);
+        }
+    }
+}
+
+// Copies a native mesh into JS arrays and frees it.
+function takeMesh(ptr) {
+    const n = lib();
+    try {
+        const vertexCount = Number(n.mesh_vertex_count(ptr));
+        const triangleCount = Number(n.mesh_triangle_count(ptr));
+        return {
+            vertices: copyArray(n.mesh_vertices(ptr), 'double', 3 * vertexCount),
+            faces: copyArray(n.mesh_triangles(ptr), 'uint32_t', 3 * triangleCount),
+            normals: copyArray(n.mesh_normals(ptr), 'double', 3 * vertexCount),
+        };
+    } finally {
+        n.mesh_destroy(ptr);
+    }
+}
+
+// ---- one call ----------------------------------------------------------------------------
+
+/**
+ * Unoriented points in, closed outward-facing mesh out: set points → fit → orient →
+ * polygonize with the given parameters. Returns { vertices, faces, normals }.
+ */
+export function reconstruct(points, options = {}) {
+    if (!isPointSource(points)) throw invalidArgument(`points must be point coordinates, a PointCloud or a path; got ${describe(points)}`);
+    const surface = new Surface(points, options);
+    try {
+        return surface.fit().orient().polygonize();
+    } finally {
+        surface.close();
+    }
+}
+
+// ---- files -------------------------------------------------------------------------------
+
+/** Reads a point cloud (.ply, .xyz, .txt, .off, .obj): { positions, normals | null, count }. */
+export function readPoints(file) {
+    const p = toPath(file);
+    const n = lib();
+    const out = [null];
+    check(n.points_read(p, out));
+    const ptr = out[0];
+    try {
+        const count = Number(n.points_count(ptr));
+        return {
+            positions: copyArray(n.points_positions(ptr), 'double', 3 * count),
+            normals: copyArray(n.points_normals(ptr), 'double', 3 * count),
+            count,
+        };
+    } finally {
+        n.points_destroy(ptr);
+    }
+}
+
+/**
+ * Writes a mesh { vertices, faces } (.ply binary little-endian, .obj, .off; from the
+ * extension), atomically. Vertex normals are not written: the C ABI builds meshes from
+ * positions and triangles only.
+ */
+export function writeMesh(file, mesh) {
+    const p = toPath(file);
+    if (mesh === null || typeof mesh !== 'object') throw invalidArgument('mesh must be an object { vertices, faces }');
+    const { data: vertices, count: vertexCount } = toXyz(mesh.vertices, 'mesh.vertices', { allowF32: false });
+    const faces = toFaces(mesh.faces, 'mesh.faces');
+    const n = lib();
+    const out = [null];
+    check(n.mesh_create(vertexCount ? vertices : null, vertexCount, faces.length ? faces : null, faces.length / 3, out));
+    try {
+        check(n.mesh_write(out[0], p));
+    } finally {
+        n.mesh_destroy(out[0]);
+    }
+}
+
+/** Writes points and optional normals (.ply binary little-endian, or .xyz), atomically. */
+export function writePoints(file, cloud) {
+    const p = toPath(file);
+    if (cloud === null || typeof cloud !== 'object') throw invalidArgument('cloud must be an object { positions, normals? }');
+    const { data: positions, count } = toXyz(cloud.positions, 'positions', { allowF32: false });
+    let normals = null;
+    if (cloud.normals !== undefined && cloud.normals !== null) {
+        const nn = toXyz(cloud.normals, 'normals', { allowF32: false });
+        if (nn.count !== count)
+            throw jsError('GMPU_ERROR_INVALID_INPUT', `${nn.count} normals for ${count} points`);
+        normals = nn.data;
+    }
+    const n = lib();
+    const out = [null];
+    check(n.points_create(count ? positions : null, count ? normals : null, count, out));
+    try {
+        check(n.points_write(out[0], p));
+    } finally {
+        n.points_destroy(out[0]);
+    }
+}
+
+// ---- library -----------------------------------------------------------------------------
+
+/** Version of the loaded C library and where it was loaded from. */
+export function libraryInfo() {
+    const n = lib();
+    return {
+        version: n.version_string(),
+        versionNumber: n.version_number(),
+        abiVersion: n.abi_version(),
+        path: n.path,
+    };
+}

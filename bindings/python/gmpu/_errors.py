@@ -1,0 +1,108 @@
+"""Exceptions: one gmpu.Error subclass per C status, each carrying the C status and message."""
+from __future__ import annotations
+
+from typing import Dict, Type
+
+from ._library import ffi, lib
+
+__all__ = [
+    "Error", "InvalidArgumentError", "InvalidInputError", "DegenerateInputError", "WrongOrderError",
+    "OutOfMemoryError", "LimitExceededError", "CancelledError", "IoError", "ParseError",
+    "UnsupportedError", "InternalError", "check",
+]
+
+
+class Error(Exception):
+    """A gmpu C call failed.
+
+    Attributes:
+        status: the C ``gmpu_status`` value (int).
+        status_name: its enumerator name, e.g. ``"GMPU_ERROR_INVALID_INPUT"``.
+        message: the library's message (``gmpu_last_error()``), which starts with the name.
+        function: the C function that failed, e.g. ``"gmpu_surface_set_points_f64"``.
+    """
+
+    def __init__(self, message: str, status: int = -1, status_name: str = "", function: str = ""):
+        super().__init__(message)
+        self.message = message
+        self.status = status
+        self.status_name = status_name
+        self.function = function
+
+
+class InvalidArgumentError(Error, ValueError):
+    """GMPU_ERROR_INVALID_ARGUMENT: a parameter out of range, a bad count or stride."""
+
+
+class InvalidInputError(Error, ValueError):
+    """GMPU_ERROR_INVALID_INPUT: NaN/inf coordinates, too few points, a size mismatch."""
+
+
+class DegenerateInputError(Error, ValueError):
+    """GMPU_ERROR_DEGENERATE_INPUT: identical, collinear or coplanar points bound no solid."""
+
+
+class WrongOrderError(Error, RuntimeError):
+    """GMPU_ERROR_WRONG_ORDER: a stage was called before the one it needs (fit, then orient)."""
+
+
+class OutOfMemoryError(Error, MemoryError):
+    """GMPU_ERROR_OUT_OF_MEMORY."""
+
+
+class LimitExceededError(Error, RuntimeError):
+    """GMPU_ERROR_LIMIT_EXCEEDED: the max_cells or max_triangles cap was hit."""
+
+
+class CancelledError(Error):
+    """GMPU_ERROR_CANCELLED without a Python exception to re-raise (rare: the progress
+    callback's own exception is re-raised instead whenever there is one)."""
+
+
+class IoError(Error, OSError):
+    """GMPU_ERROR_IO: a file could not be opened, read or written."""
+
+
+class ParseError(Error, ValueError):
+    """GMPU_ERROR_PARSE: a file's contents are malformed or truncated."""
+
+
+class UnsupportedError(Error, ValueError):
+    """GMPU_ERROR_UNSUPPORTED: unknown file extension or format variant."""
+
+
+class InternalError(Error, RuntimeError):
+    """GMPU_ERROR_INTERNAL: a bug in gmpu; please report it with the message."""
+
+
+#: C status name → exception class. A status the library gains later maps to Error itself.
+ERROR_CLASSES: Dict[str, Type[Error]] = {
+    "GMPU_ERROR_INVALID_ARGUMENT": InvalidArgumentError,
+    "GMPU_ERROR_INVALID_INPUT": InvalidInputError,
+    "GMPU_ERROR_DEGENERATE_INPUT": DegenerateInputError,
+    "GMPU_ERROR_WRONG_ORDER": WrongOrderError,
+    "GMPU_ERROR_OUT_OF_MEMORY": OutOfMemoryError,
+    "GMPU_ERROR_LIMIT_EXCEEDED": LimitExceededError,
+    "GMPU_ERROR_CANCELLED": CancelledError,
+    "GMPU_ERROR_IO": IoError,
+    "GMPU_ERROR_PARSE": ParseError,
+    "GMPU_ERROR_UNSUPPORTED": UnsupportedError,
+    "GMPU_ERROR_INTERNAL": InternalError,
+}
+
+
+def error_from_status(status: int, function: str) -> Error:
+    """The exception for a failed call, read on the thread that made it (gmpu_last_error is
+    per thread and valid until the next gmpu call there)."""
+    name = ffi.string(lib.gmpu_status_name(status)).decode()
+    message = ffi.string(lib.gmpu_last_error()).decode("utf-8", "replace")
+    if not message:
+        message = f"{name}: {function} failed"
+    cls = ERROR_CLASSES.get(name, Error)
+    return cls(message, status=int(status), status_name=name, function=function)
+
+
+def check(status: int, function: str) -> None:
+    """Raises the matching Error unless status is GMPU_OK."""
+    if status != 0:
+        raise error_from_status(status, function)

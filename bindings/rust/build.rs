@@ -1,0 +1,150 @@
+//! Finds libgmpu and extracts the README's Rust example for `tests/readme.rs`.
+//!
+//! Library search order (the first that applies wins):
+//!   1. `GMPU_LIB_DIR`: a directory holding libgmpu.so;
+//!   2. pkg-config's `gmpu.pc`, if installed (`pkg-config --libs gmpu`, run as a command;
+//!      PKG_CONFIG_PATH is honoured);
+//!   3. the meson build directory of this source tree, `../../build/lib`.
+//! Every directory found this way is also put in the rpath of the crate's tests, examples
+//! and binaries, so they run without LD_LIBRARY_PATH.
+use std::env;
+use std::fs;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn has_library(dir: &Path) -> bool {
+    ["libgmpu.so", "libgmpu.dylib", "gmpu.lib"]
+        .iter()
+        .any(|f| dir.join(f).exists())
+}
+
+/// `-L` directories and `-l` libraries of `pkg-config --libs gmpu`, or None when pkg-config
+/// is missing or has no gmpu.pc.
+fn pkg_config() -> Option<(Vec<String>, Vec<String>)> {
+    let pkg_config = env::var("PKG_CONFIG").unwrap_or_else(|_| "pkg-config".to_string());
+    let out = Command::new(pkg_config).args(["--libs", "gmpu"]).output().ok()?;
+    if !out.status.success() {
+        return None;
+    }
+    let text = String::from_utf8(out.stdout).ok()?;
+    let mut dirs = Vec::new();
+    let mut libs = Vec::new();
+    for word in text.split_whitespace() {
+        if let Some(d) = word.strip_prefix("-L") {
+            dirs.push(d.to_string());
+        } else if let Some(l) = word.strip_prefix("-l") {
+            libs.push(l.to_string());
+        }
+    }
+    if !libs.iter().any(|l| l == "gmpu") {
+        return None;
+    }
+    Some((dirs, libs))
+}
+
+fn link_dir(dir: &str) {
+    println!("cargo:rustc-link-search=native={dir}");
+    // rpath for everything this package links (tests, examples, binaries); a dependent crate
+    // sets its own. DEP_GMPU_LIB_DIR carries the directory to it (links = "gmpu").
+    if cfg!(target_os = "linux") || cfg!(target_os = "macos") {
+        println!("cargo:rustc-link-arg=-Wl,-rpath,{dir}");
+    }
+}
+
+fn find_library() {
+    println!("cargo:rerun-if-env-changed=GMPU_LIB_DIR");
+    println!("cargo:rerun-if-env-changed=PKG_CONFIG_PATH");
+    println!("cargo:rerun-if-env-changed=PKG_CONFIG");
+    let manifest = PathBuf::from(env::var("CARGO_MANIFEST_DIR").unwrap());
+
+    if let Some(dir) = env::var_os("GMPU_LIB_DIR").filter(|d| !d.is_empty()) {
+        let dir = PathBuf::from(dir);
+        let dir = if dir.is_relative() { manifest.join(dir) } else { dir };
+        if !has_library(&dir) {
+            panic!("GMPU_LIB_DIR={} holds no libgmpu (build it with `make build`)", dir.display());
+        }
+        let dir = dir.canonicalize().unwrap_or(dir);
+        let d = dir.to_string_lossy().into_owned();
+        link_dir(&d);
+        println!("cargo:root={d}");
+        println!("cargo:rustc-link-lib=dylib=gmpu");
+        return;
+    }
+
+    if let Some((dirs, libs)) = pkg_config() {
+        for d in &dirs {
+            link_dir(d);
+        }
+        if let Some(d) = dirs.first() {
+            println!("cargo:root={d}");
+        }
+        for l in libs {
+            println!("cargo:rustc-link-lib={l}");
+        }
+        return;
+    }
+
+    let build = manifest.join("../../build/lib");
+    println!("cargo:rerun-if-changed={}", build.join("libgmpu.so").display());
+    if has_library(&build) {
+        let dir = build.canonicalize().unwrap_or(build);
+        let d = dir.to_string_lossy().into_owned();
+        link_dir(&d);
+        println!("cargo:root={d}");
+        println!("cargo:rustc-link-lib=dylib=gmpu");
+        return;
+    }
+
+    panic!(
+        "libgmpu not found: set GMPU_LIB_DIR to the directory holding libgmpu.so, install gmpu \
+         (meson install, so that `pkg-config --libs gmpu` works), or build it in this tree with \
+         `make build` (expected at {})",
+        build.display()
+    );
+}
+
+/// Writes the README's Rust example (the one ```rust block between `<!-- rust:begin -->`
+/// and `<!-- rust:end -->`) to OUT_DIR/readme_example.rs for tests/readme.rs. A README
+/// without it becomes a compile error in that test, not a silent pass.
+fn extract_readme_example() {
+    let readme = PathBuf::from(env::var("CARGO_MANIFEST_DIR").unwrap()).join("../../README.md");
+    println!("cargo:rerun-if-changed={}", readme.display());
+    let out = PathBuf::from(env::var("OUT_DIR").unwrap()).join("readme_example.rs");
+    let code = match fs::read_to_string(&readme) {
+        Err(e) => Err(format!("cannot read {}: {e}", readme.display())),
+        Ok(text) => readme_block(&text),
+    };
+    let code = code.unwrap_or_else(|why| format!("compile_error!({why:?});\n"));
+    fs::write(out, code).expect("write OUT_DIR/readme_example.rs");
+}
+
+fn readme_block(text: &str) -> Result<String, String> {
+    let begin = text.find("<!-- rust:begin -->").ok_or("README.md has no <!-- rust:begin --> marker")?;
+    let end = text[begin..].find("<!-- rust:end -->").ok_or("README.md has no <!-- rust:end --> marker")?;
+    let section = &text[begin..begin + end];
+    let mut blocks = Vec::new();
+    let mut current: Option<String> = None;
+    for line in section.lines() {
+        let trimmed = line.trim_start();
+        match current.as_mut() {
+            None if trimmed.starts_with("```rust") => current = Some(String::new()),
+            None => {}
+            Some(_) if trimmed.starts_with("```") => blocks.push(current.take().unwrap()),
+            Some(code) => {
+                code.push_str(line);
+                code.push('\n');
+            }
+        }
+    }
+    match blocks.len() {
+        1 => Ok(blocks.pop().unwrap()),
+        0 => Err("the README's Rust section has no ```rust block".into()),
+        n => Err(format!("the README's Rust section has {n} ```rust blocks; expected exactly one program")),
+    }
+}
+
+fn main() {
+    println!("cargo:rerun-if-changed=build.rs");
+    find_library();
+    extract_readme_example();
+}

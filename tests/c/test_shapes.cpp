@@ -1,0 +1,215 @@
+// The whole pipeline through the C ABI on solids known in closed form: exact distances,
+// orientation against the true outward normals, topology, and the sign of f off the
+// surface. Each shape exercises a part of the paper: a sphere (general quadric cells), a
+// torus (a handle), nested spheres (a shell inside a shell: the inner normals must point
+// into the cavity), a thin plate (two close sheets BP must not merge), islands.
+#include <cmath>
+#include <cstring>
+#include <vector>
+
+#include "analytic_shapes.hpp"
+#include "mesh_checks.hpp"
+#include "metrics.hpp"
+#include "reconstruct.hpp"
+
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+extern "C" {
+#include <cmocka.h>
+}
+
+using namespace gmpu::testing;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+struct Expectation {
+    size_t components;
+    int genus;               // of every component
+    double min_orientation;  // share of points with outward normals
+    double max_mean_distance;  // mesh → true surface, fraction of the bbox diagonal
+    double max_gap;            // true surface → mesh, worst case, fraction of the diagonal
+};
+
+double diagonal(const AnalyticShape &s) { return s.bounds().diagonal().norm(); }
+
+// Reconstructs `count` samples of the shape and checks the mesh and the normals.
+Reconstruction check_shape(const AnalyticShape &shape, size_t count, const Expectation &e,
+                           const std::vector<std::pair<gmpu_param, double>> &params = {}) {
+    OrientedPoints pts = shape.sample(count, 7);
+    Reconstruction r = reconstruct(pts.positions, params);
+    if (r.status != GMPU_OK) fprintf(stderr, "reconstruction failed: %s\n", r.error.c_str());
+    assert_int_equal(r.status, GMPU_OK);
+
+    MeshCheck check = check_mesh(r.mesh);
+    assert_true(check.watertight);
+    assert_int_equal(check.nonmanifold_vertices, 0);
+    assert_int_equal(check.components, e.components);
+    for (const auto &c : check.component_reports) assert_int_equal(c.genus, e.genus);
+
+    OrientationScore o = orientation_accuracy(r.normals, pts.normals);
+    ShapeDeviation d = compare_to_shape(r.mesh, shape, 20000, 3);
+    const double diag = diagonal(shape);
+    fprintf(stderr, "  orientation %.4f%%, mean distance %.5f%%, max gap %.4f%% of the diagonal, %zu triangles\n",
+            100 * o.accuracy, 100 * d.mean_distance / diag, 100 * d.max_gap / diag, r.mesh.triangles.size());
+    assert_true(o.accuracy >= e.min_orientation);
+    assert_true(d.mean_distance <= e.max_mean_distance * diag);
+    assert_true(d.max_gap <= e.max_gap * diag);
+    assert_true(d.normal_agreement > 0.98);
+    assert_true(d.inward_share < 0.005);
+    // Outward winding: the enclosed volume is positive and close to the solid's.
+    assert_true(check.signed_volume > 0.97 * shape.volume() && check.signed_volume < 1.03 * shape.volume());
+    return r;
+}
+
+// f is positive inside, negative outside, at points clearly off the surface.
+void check_signs(const Reconstruction &r, const AnalyticShape &shape, const std::vector<Vec3> &probes) {
+    std::vector<double> f = r.evaluate(probes);
+    assert_int_equal(f.size(), probes.size());
+    for (size_t i = 0; i < probes.size(); ++i) {
+        const bool inside = shape.signed_distance(probes[i]) < 0;
+        if (inside != (f[i] > 0)) fprintf(stderr, "  wrong sign at probe %zu: f = %g\n", i, f[i]);
+        assert_true(inside == (f[i] > 0));
+    }
+}
+
+void sphere(void **) {
+    Sphere shape({0.2, -0.1, 0.3}, 1.0);
+    Reconstruction r = check_shape(shape, 20000, {1, 0, 0.999, 0.0005, 0.01});
+    check_signs(r, shape, {{0.2, -0.1, 0.3}, {0.9, -0.1, 0.3}, {1.5, -0.1, 0.3}, {5, 5, 5}, {-40, 3, 1}, {0.2, -0.1, -0.65}});
+    // Near the surface f is about the signed distance, in the caller's units, and ∇f points
+    // inward with about unit length.
+    std::vector<Vec3> grads;
+    std::vector<double> f = r.evaluate({{1.23, -0.1, 0.3}, {1.17, -0.1, 0.3}}, &grads);
+    assert_true(std::abs(f[0] - (-0.03)) < 0.01 && std::abs(f[1] - 0.03) < 0.01);
+    for (const Vec3 &g : grads) {
+        assert_true(g.normalized().dot(Vec3(-1, 0, 0)) > 0.99);
+        assert_true(g.norm() > 0.8 && g.norm() < 1.25);
+    }
+}
+
+void torus(void **) {
+    Torus shape({0, 0, 0}, 1.0, 0.3);
+    Reconstruction r = check_shape(shape, 30000, {1, 1, 0.999, 0.0005, 0.01});
+    check_signs(r, shape, {{0, 0, 0}, {1, 0, 0}, {0, -1, 0}, {0, 0, 0.5}, {1.5, 0, 0}, {0.71, 0.71, 0.1}});
+}
+
+void nested_spheres(void **) {
+    NestedSpheres shape({0, 0, 0}, 0.6, 1.0);
+    Reconstruction r = check_shape(shape, 30000, {2, 0, 0.999, 0.0005, 0.01});
+    // The solid is the shell: the cavity and the outside are both negative.
+    check_signs(r, shape, {{0, 0, 0}, {0.8, 0, 0}, {0, -0.8, 0}, {0, 0, 0.3}, {1.3, 0, 0}, {0.45, 0.45, 0.45}});
+}
+
+void thin_plate(void **) {
+    // 2 × 2 × 0.08: its two faces are a few sample spacings apart.
+    Plate shape({0, 0, 0}, {1.0, 1.0, 0.04});
+    Reconstruction r = check_shape(shape, 40000, {1, 0, 0.995, 0.001, 0.01});
+    check_signs(r, shape, {{0, 0, 0}, {0.5, -0.5, 0.01}, {0, 0, 0.1}, {0, 0, -0.1}, {0.9, 0.9, 0}});
+}
+
+void islands(void **) {
+    // Three separate spheres of different sizes: each piece outward on its own.
+    Sphere a({0, 0, 0}, 1.0), b({3, 0, 0}, 0.5), c({0, 2.5, 0.5}, 0.3);
+    OrientedPoints pa = a.sample(12000, 1), pb = b.sample(4000, 2), pc = c.sample(2000, 3);
+    std::vector<Vec3> pts = pa.positions, normals = pa.normals;
+    for (const OrientedPoints *p : {&pb, &pc}) {
+        pts.insert(pts.end(), p->positions.begin(), p->positions.end());
+        normals.insert(normals.end(), p->normals.begin(), p->normals.end());
+    }
+    Reconstruction r = reconstruct(pts);
+    assert_int_equal(r.status, GMPU_OK);
+    MeshCheck check = check_mesh(r.mesh);
+    assert_true(check.watertight);
+    assert_int_equal(check.components, 3);
+    for (const auto &comp : check.component_reports) assert_true(comp.signed_volume > 0);
+    assert_true(orientation_accuracy(r.normals, normals).accuracy >= 0.999);
+    std::vector<double> f = r.evaluate({{0, 0, 0}, {3, 0, 0}, {0, 2.5, 0.5}, {1.7, 0, 0}, {0, 1.6, 0.3}});
+    assert_true(f[0] > 0 && f[1] > 0 && f[2] > 0 && f[3] < 0 && f[4] < 0);
+}
+
+void scale_invariance(void **) {
+    // The same sphere at 1e-6 and 1e6 scale (and far from the origin) gives the same mesh
+    // up to the scale: everything works in a normalised frame.
+    Sphere unit({0, 0, 0}, 1.0);
+    OrientedPoints pts = unit.sample(8000, 5);
+    size_t triangles = 0;
+    for (double scale : {1e-6, 1.0, 1e6}) {
+        std::vector<Vec3> p;
+        for (const Vec3 &x : pts.positions) p.push_back(scale * x + Vec3(3 * scale, 0, 0));
+        Reconstruction r = reconstruct(p);
+        assert_int_equal(r.status, GMPU_OK);
+        if (triangles == 0) triangles = r.mesh.triangles.size();
+        assert_int_equal(r.mesh.triangles.size(), triangles);
+        double mean_radius = 0;
+        for (const Vec3 &v : r.mesh.vertices) mean_radius += (v - Vec3(3 * scale, 0, 0)).norm() / scale;
+        mean_radius /= double(r.mesh.vertices.size());
+        assert_true(std::abs(mean_radius - 1.0) < 0.002);
+    }
+}
+
+void input_normals_decide_the_sign(void **) {
+    // With normals given, BP is skipped and the normals are obeyed, even when they say the
+    // sphere is a cavity (normals pointing in): then f is negative at the centre.
+    Sphere shape({0, 0, 0}, 1.0);
+    OrientedPoints pts = shape.sample(10000, 9);
+    Reconstruction out = reconstruct(pts.positions, {}, &pts.normals);
+    assert_int_equal(out.status, GMPU_OK);
+    assert_true(orientation_accuracy(out.normals, pts.normals).accuracy >= 0.999);
+    assert_true(out.evaluate({{0, 0, 0}})[0] > 0);
+
+    std::vector<Vec3> inward;
+    for (const Vec3 &n : pts.normals) inward.push_back(-n);
+    Reconstruction in = reconstruct(pts.positions, {}, &inward);
+    assert_int_equal(in.status, GMPU_OK);
+    assert_true(orientation_accuracy(in.normals, inward).accuracy >= 0.999);
+    assert_true(in.evaluate({{0, 0, 0}})[0] < 0);
+}
+
+void level_of_detail(void **) {
+    // Capping the octree level blends coarser cells: a cruder but still closed surface, and
+    // the full-detail one is closer to the truth.
+    Torus shape({0, 0, 0}, 1.0, 0.3);
+    OrientedPoints pts = shape.sample(30000, 4);
+    Reconstruction fine = reconstruct(pts.positions, {{GMPU_PARAM_RESOLUTION, 96}});
+    Reconstruction coarse = reconstruct(pts.positions, {{GMPU_PARAM_RESOLUTION, 96}, {GMPU_PARAM_LEVEL, 3}});
+    assert_int_equal(fine.status, GMPU_OK);
+    assert_int_equal(coarse.status, GMPU_OK);
+    assert_true(check_mesh(coarse.mesh).watertight);
+    ShapeDeviation df = compare_to_shape(fine.mesh, shape), dc = compare_to_shape(coarse.mesh, shape);
+    fprintf(stderr, "  level 3 mean distance %.5f, full %.5f\n", dc.mean_distance, df.mean_distance);
+    assert_true(dc.mean_distance > 2 * df.mean_distance);
+    // evaluate honours the cap too.
+    std::vector<double> a = fine.evaluate({{1.25, 0.1, 0.05}}), b = coarse.evaluate({{1.25, 0.1, 0.05}});
+    assert_true(a[0] != b[0]);
+}
+
+void deterministic(void **) {
+    Torus shape({0, 0, 0}, 1.0, 0.35);
+    OrientedPoints pts = shape.sample(15000, 11);
+    Reconstruction a = reconstruct(pts.positions), b = reconstruct(pts.positions, {{GMPU_PARAM_THREADS, 1}});
+    assert_int_equal(a.mesh.vertices.size(), b.mesh.vertices.size());
+    assert_int_equal(a.mesh.triangles.size(), b.mesh.triangles.size());
+    for (size_t i = 0; i < a.mesh.vertices.size(); ++i) assert_true(a.mesh.vertices[i] == b.mesh.vertices[i]);
+    assert_memory_equal(a.mesh.triangles.data(), b.mesh.triangles.data(), a.mesh.triangles.size() * sizeof(Triangle));
+}
+
+}  // namespace
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(sphere),
+        cmocka_unit_test(torus),
+        cmocka_unit_test(nested_spheres),
+        cmocka_unit_test(thin_plate),
+        cmocka_unit_test(islands),
+        cmocka_unit_test(scale_invariance),
+        cmocka_unit_test(input_normals_decide_the_sign),
+        cmocka_unit_test(level_of_detail),
+        cmocka_unit_test(deterministic),
+    };
+    return cmocka_run_group_tests(tests, nullptr, nullptr);
+}
