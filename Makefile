@@ -63,6 +63,16 @@ test-node: build
 	node --test tests/node/
 
 test-rust: build
+	@command -v cargo >/dev/null || { echo "test-rust: cargo not found (Rust >= 1.77 is needed)"; exit 1; }
+	cd bindings/rust && GMPU_LIB_DIR=$(abspath $(BUILD))/lib cargo test --offline
+	$(MAKE) --no-print-directory test-cross
+
+# Same input and parameters -> same mesh in C, Python, Node and Rust (tests/cross/).
+.PHONY: test-cross
+test-cross: build
+	@for d in bindings/node examples/node; do [ -d $$d/node_modules ] || \
+	  (cd $$d && npm ci --no-audit --no-fund --loglevel=error) || exit 1; done
+	$(PYTHON) tests/cross/cross_language.py --build $(BUILD)
 
 test-sanitize: deps-test
 

@@ -54,7 +54,9 @@ export type Stage = 'fit' | 'orient' | 'polygonize';
  * 'GMPU_ERROR_CANCELLED'); throwing cancels it too, and the stage rethrows your error.
  * The Surface keeps the stages completed before the cancelled one. It must not use the
  * Surface it reports on (that throws, and so cancels); calling close() cancels the stage
- * and closes the surface once it has returned.
+ * and closes the surface once it has returned. A cancel that comes with a stage's last
+ * report (fraction 1, or the only report of a trivial stage) is too late: the C library
+ * completes the stage and `false` is then ignored, while a thrown error is still rethrown.
  */
 export type ProgressCallback = (stage: Stage, fraction: number) => boolean | void;
 

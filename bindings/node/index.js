@@ -407,6 +407,10 @@ export class Surface {
         try {
             for (const [name, value] of overrides) this.setParam(name, value);
             this.#stage((h) => lib().surface_polygonize(h, out));
+        } catch (err) {
+            // The stage may have completed while onProgress threw at its very end.
+            if (out[0] !== null) lib().mesh_destroy(out[0]);
+            throw err;
         } finally {
             if (!this.closed) for (const [name, value] of saved) this.setParam(name, value);
         }

@@ -5,6 +5,7 @@
 //!   2. pkg-config's `gmpu.pc`, if installed (`pkg-config --libs gmpu`, run as a command;
 //!      PKG_CONFIG_PATH is honoured);
 //!   3. the meson build directory of this source tree, `../../build/lib`.
+//!
 //! Every directory found this way is also put in the rpath of the crate's tests, examples
 //! and binaries, so they run without LD_LIBRARY_PATH.
 use std::env;
@@ -13,9 +14,7 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 fn has_library(dir: &Path) -> bool {
-    ["libgmpu.so", "libgmpu.dylib", "gmpu.lib"]
-        .iter()
-        .any(|f| dir.join(f).exists())
+    ["libgmpu.so", "libgmpu.dylib", "gmpu.lib"].iter().any(|f| dir.join(f).exists())
 }
 
 /// `-L` directories and `-l` libraries of `pkg-config --libs gmpu`, or None when pkg-config
@@ -45,7 +44,7 @@ fn pkg_config() -> Option<(Vec<String>, Vec<String>)> {
 fn link_dir(dir: &str) {
     println!("cargo:rustc-link-search=native={dir}");
     // rpath for everything this package links (tests, examples, binaries); a dependent crate
-    // sets its own. DEP_GMPU_LIB_DIR carries the directory to it (links = "gmpu").
+    // sets its own. DEP_GMPU_ROOT carries the directory to it (links = "gmpu", `cargo:root`).
     if cfg!(target_os = "linux") || cfg!(target_os = "macos") {
         println!("cargo:rustc-link-arg=-Wl,-rpath,{dir}");
     }

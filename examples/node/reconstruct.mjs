@@ -65,12 +65,11 @@ const onProgress = args.quiet
         lastStage = stage;
     };
 
-const surface = new Surface();
+let surface = null;
 try {
     const cloud = readPoints(args.input);
-    for (const [name, value] of Object.entries(args.options)) surface.setParam(name, value);
-    surface.onProgress = onProgress;
-    const mesh = surface.fit(cloud.positions).orient().polygonize();
+    surface = new Surface(cloud, { ...args.options, onProgress });
+    const mesh = surface.fit().orient().polygonize();
     writeMesh(args.output, mesh);
     if (args.normalsOut) writePoints(args.normalsOut, { positions: cloud.positions, normals: surface.normals() });
     if (!args.quiet) {
@@ -87,5 +86,5 @@ try {
     console.error(`reconstruct.mjs: ${err.message}`);
     process.exitCode = 1;
 } finally {
-    surface.close();
+    surface?.close();
 }

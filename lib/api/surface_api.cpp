@@ -332,7 +332,7 @@ GMPU_API gmpu_status gmpu_surface_orient(gmpu_surface *s) {
         measures.normals = gmpu::point_normals(f, s->points, threads, progress,
                                                0.9 * double(s->points.size()) / 0.05,
                                                double(s->points.size()) / 0.05);
-        gmpu::measure_points(s->points, threads, progress, measures);
+        gmpu::measure_points(tree, s->points, threads, progress, measures);
         s->measures = std::move(measures);
         s->winding = gmpu::WindingField(tree, s->points, s->measures.normals, s->measures.area);
         progress.report(1.0, true);

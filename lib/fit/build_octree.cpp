@@ -12,6 +12,9 @@ namespace gmpu {
 
 namespace {
 
+// Supports larger than this (estimated) are taken from the coarse subsample.
+constexpr double kFullSupport = 16384;
+
 struct Builder {
     const PointSet &points;
     const Params &params;
@@ -37,7 +40,14 @@ struct Builder {
         if (!cube_has_points && points.count_within(c.centre, c.size, 1) == 0) return false;
         idx.clear();
         c.radius = support_radius(c.size);
-        points.within(c.centre, c.radius, idx);
+        // Coarse cells of a big cloud: their support holds a large share of all points, and
+        // a uniform subsample of it fits as well (the fit uses 2048 points at most anyway).
+        points.coarse_within(c.centre, c.radius, idx);
+        const double estimate = double(idx.size()) * points.coarse_ratio();
+        if (estimate <= kFullSupport) {
+            idx.clear();
+            points.within(c.centre, c.radius, idx);
+        }
         const size_t nmin = size_t(params.min_points);
         c.initial_count = uint32_t(std::min(idx.size(), nmin));
         if (idx.size() < nmin) {
@@ -49,7 +59,7 @@ struct Builder {
         support.resize(idx.size());
         for (size_t k = 0; k < idx.size(); ++k) support[k] = points.point(idx[k]) - c.centre;
         CellFit f = fit_cell(support, c.radius, epsilon, params);
-        c.support_count = uint32_t(idx.size());
+        c.support_count = uint32_t(std::max(double(idx.size()), estimate));
         c.error = float(f.error);
         c.variation = float(f.variation);
         c.shape = f.shape;

@@ -13,13 +13,15 @@ namespace gmpu {
 
 namespace {
 
-// nanoflann reads the points in place through this adaptor (no copy). It holds the
-// buffer, not the vector, so moving the PointSet (which keeps the buffer) keeps it valid.
+// nanoflann reads the points in place through this adaptor (no copy), optionally through
+// a list of ids (the coarse subsample). It holds buffers, not vectors, so moving the
+// PointSet (which keeps the buffers) keeps it valid.
 struct CloudAdaptor {
     const float *pts;
     size_t count;
+    const uint32_t *ids = nullptr;
     size_t kdtree_get_point_count() const { return count; }
-    float kdtree_get_pt(size_t i, size_t dim) const { return pts[3 * i + dim]; }
+    float kdtree_get_pt(size_t i, size_t dim) const { return pts[3 * (ids ? ids[i] : i) + dim]; }
     template <class Box>
     bool kdtree_get_bbox(Box &) const { return false; }
 };
@@ -88,8 +90,8 @@ struct BoundedKnnResultSet {
 struct PointSet::Index {
     CloudAdaptor adaptor;
     KdTree tree;
-    explicit Index(const std::vector<float> &pts)
-        : adaptor{pts.data(), pts.size() / 3}, tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {
+    explicit Index(const std::vector<float> &pts, const std::vector<uint32_t> *ids = nullptr)
+        : adaptor{pts.data(), ids ? ids->size() : pts.size() / 3, ids ? ids->data() : nullptr}, tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {
         tree.buildIndex();
     }
 };
@@ -167,7 +169,27 @@ PointSet PointSet::from_array(const T *xyz, size_t count, size_t stride, size_t 
 template PointSet PointSet::from_array<double>(const double *, size_t, size_t, size_t);
 template PointSet PointSet::from_array<float>(const float *, size_t, size_t, size_t);
 
-void PointSet::build_index() { index_ = std::make_unique<Index>(points_); }
+void PointSet::build_index() {
+    index_ = std::make_unique<Index>(points_);
+    const size_t n = size();
+    if (n <= 2 * kCoarsePoints) return;
+    // Every m-th point of a fixed pseudo-random order: uniform over the surface whatever
+    // order the input came in (scan lines, sorted files).
+    const uint64_t m = (n + kCoarsePoints - 1) / kCoarsePoints;
+    for (uint32_t i = 0; i < n; ++i)
+        if ((uint64_t(i) * 0x9E3779B97F4A7C15ull >> 32) % m == 0) coarse_ids_.push_back(i);
+    coarse_ratio_ = double(n) / double(coarse_ids_.size());
+    coarse_index_ = std::make_unique<Index>(points_, &coarse_ids_);
+}
+
+void PointSet::coarse_within(const Eigen::Vector3d &c, double radius, std::vector<uint32_t> &out) const {
+    if (!coarse_index_) return within(c, radius, out);
+    const float q[3] = {float(c[0]), float(c[1]), float(c[2])};
+    const size_t first = out.size();
+    CollectingResultSet rs{float(radius * radius), &out};
+    coarse_index_->tree.findNeighbors(rs, q, nanoflann::SearchParams(32, 0.0f, false));
+    for (size_t k = first; k < out.size(); ++k) out[k] = coarse_ids_[out[k]];
+}
 
 void PointSet::within(const Eigen::Vector3d &c, double radius, std::vector<uint32_t> &out) const {
     const float q[3] = {float(c[0]), float(c[1]), float(c[2])};

@@ -48,6 +48,13 @@ public:
 
     // Indices of the points within `radius` of `centre` (normalised frame), appended to out.
     void within(const Eigen::Vector3d &centre, double radius, std::vector<uint32_t> &out) const;
+    // The same on a fixed, spatially uniform subsample of at most kCoarsePoints points
+    // (all points when there are few): for cells so large that a full support would only
+    // cost time. Indices refer to the full set; coarse_ratio() = size() / subsample size.
+    void coarse_within(const Eigen::Vector3d &centre, double radius, std::vector<uint32_t> &out) const;
+    double coarse_ratio() const { return coarse_ratio_; }
+    static constexpr size_t kCoarsePoints = 1u << 16;
+
     // Number of points within `radius`, stopping early once `enough` are found.
     size_t count_within(const Eigen::Vector3d &centre, double radius, size_t enough) const;
     // The k nearest points (indices and squared distances, nearest first), only among those
@@ -61,7 +68,9 @@ private:
     Normalisation norm_;
     Eigen::Vector3d box_min_, box_max_;
     double world_diagonal_ = 0.0;
-    std::unique_ptr<Index> index_;
+    std::unique_ptr<Index> index_, coarse_index_;
+    std::vector<uint32_t> coarse_ids_;
+    double coarse_ratio_ = 1.0;
     void build_index();
 };
 

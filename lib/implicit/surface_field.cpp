@@ -12,6 +12,8 @@ constexpr size_t kNeighbours = 8;
 // gaps between samples so the trusted shell around the surface has no holes.
 constexpr double kTrustSpacings = 1.5;
 constexpr size_t kSideVotes = 8;
+// Up to this many points, measure_points searches every point's neighbours.
+constexpr size_t kExactMeasureLimit = 1u << 17;
 }  // namespace
 
 bool SurfaceField::trusted(const Eigen::Vector3d &x) const {
@@ -59,19 +61,36 @@ double SurfaceField::value_among(const std::vector<uint32_t> &leaves, const Eige
     return trusted(x) ? mpu_.value_among(leaves, x, gradient) : far_value(x, gradient);
 }
 
-void measure_points(const PointSet &points, unsigned threads, Progress &progress, PointMeasures &out) {
+void measure_points(const Octree &tree, const PointSet &points, unsigned threads, Progress &progress,
+                    PointMeasures &out) {
     const size_t n = points.size();
     out.area.assign(n, 0.0f);
     out.trust_radius.assign(n, 0.0f);
-    parallel_for(0, n, threads, progress, [&](size_t i) {
-        thread_local std::vector<uint32_t> idx;
-        thread_local std::vector<float> d2;
-        points.nearest(points.point(i), kNeighbours + 1, idx, d2);  // includes the point itself
-        double rk = std::sqrt(double(d2.back()));
+    auto set = [&](uint32_t i, double rk) {
         out.area[i] = float(M_PI * rk * rk / double(kNeighbours));
         out.trust_radius[i] = float(kTrustSpacings * rk);
-    }, 0.0, 0.0, 512);
-    progress.throw_if_cancelled();
+    };
+    if (n <= kExactMeasureLimit) {
+        // The k-th neighbour distance of every point: exact, and what sparse or nonuniform
+        // clouds need.
+        parallel_for(0, n, threads, progress, [&](size_t i) {
+            thread_local std::vector<uint32_t> idx;
+            thread_local std::vector<float> d2;
+            points.nearest(points.point(i), kNeighbours + 1, idx, d2);  // includes the point itself
+            set(uint32_t(i), std::sqrt(double(d2.back())));
+        }, 0.0, 0.0, 512);
+        progress.throw_if_cancelled();
+    } else {
+        // Dense clouds: the density of each leaf's support, as if the surface crossed its ball
+        // through the centre (π R² of area for its points), gives the k-th neighbour distance
+        // sqrt(k · area per point / π) without a million neighbour searches.
+        for (const Cell &c : tree.cells) {
+            if (!c.is_leaf() || c.point_end == c.point_begin) continue;
+            const double area = M_PI * c.radius * c.radius / double(std::max<uint32_t>(1, c.support_count));
+            const double rk = std::sqrt(double(kNeighbours) * area / M_PI);
+            for (uint32_t k = c.point_begin; k < c.point_end; ++k) set(tree.order[k], rk);
+        }
+    }
     out.widest_trust = 0.0;
     for (float r : out.trust_radius) out.widest_trust = std::max(out.widest_trust, double(r));
 }

@@ -66,7 +66,9 @@ private:
     double min_trust_, reach_;
 };
 
-// Normals are given; area and trust radius come from the k nearest neighbours.
-void measure_points(const PointSet &points, unsigned threads, class Progress &progress, PointMeasures &out);
+// Area and trust radius of every point, from its k-th neighbour distance (normals are
+// filled in separately).
+void measure_points(const Octree &tree, const PointSet &points, unsigned threads, class Progress &progress,
+                    PointMeasures &out);
 
 }  // namespace gmpu

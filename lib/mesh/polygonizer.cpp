@@ -28,6 +28,40 @@ struct BlockOutput {
     std::vector<uint32_t> votes;              // per vertex: input points in the block nearest to it
 };
 
+// The points whose trust ball may reach the block, thinned to one representative (the
+// lowest index) per voxel of half a cube, with how many points each stands for. Dense
+// clouds have tens of points per cube; their union of trust balls (at least two cubes
+// wide) hardly changes. The search reaches a voxel diagonal further so that every voxel
+// it touches is wholly inside: the representative of a voxel is then the same whichever
+// block looks, as a corner's value must be.
+void nearby_points(const BlockGrid &g, const PointSet &points, const Eigen::AlignedBox3d &box, double widest_trust,
+                   std::vector<uint32_t> &near, std::vector<uint32_t> &weight) {
+    thread_local std::vector<std::pair<uint64_t, uint32_t>> keyed;
+    thread_local std::vector<uint32_t> found;
+    const double voxel = 0.5 * g.h;
+    found.clear();
+    points.within(box.center(), 0.5 * std::sqrt(3.0) * B * g.h + widest_trust * (1.0 + 1e-5) + std::sqrt(3.0) * voxel + 1e-7,
+                  found);
+    keyed.clear();
+    for (uint32_t i : found) {
+        const Eigen::Vector3d v = (points.point(i) - g.origin) / voxel;
+        const uint64_t key = uint64_t(std::max(0.0, v[0])) | uint64_t(std::max(0.0, v[1])) << 21 |
+                             uint64_t(std::max(0.0, v[2])) << 42;
+        keyed.push_back({key, i});
+    }
+    std::sort(keyed.begin(), keyed.end());
+    near.clear();
+    weight.clear();
+    for (size_t k = 0; k < keyed.size(); ++k) {
+        if (k > 0 && keyed[k].first == keyed[k - 1].first) {
+            ++weight.back();
+            continue;
+        }
+        near.push_back(keyed[k].second);
+        weight.push_back(1);
+    }
+}
+
 // Values at the (B+1)³ corners of one band block. Each corner's value depends on its
 // position alone (never on the block), so neighbouring blocks agree on shared corners:
 //  - touching a far block: that region's sign;
@@ -111,10 +145,9 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, int64_t block, 
     const int64_t origin[3] = {x0, y0, z0};
     auto local = [](int i, int j, int k) { return i + C * (j + C * k); };
     // Every point whose trust ball may reach the block.
-    thread_local std::vector<uint32_t> near;
-    near.clear();
+    thread_local std::vector<uint32_t> near, weight;
     const Eigen::AlignedBox3d box = g.block_box(block);
-    f.points().within(box.center(), 0.5 * std::sqrt(3.0) * B * g.h + f.widest_trust() * (1.0 + 1e-5) + 1e-7, near);
+    nearby_points(g, f.points(), box, f.widest_trust(), near, weight);
     corner_values(g, f, leaves, near, origin, value);
     std::fill(slot.begin(), slot.end(), -1);
 
@@ -158,8 +191,8 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, int64_t block, 
     // data collects the votes, bubbles away from it none (see remove_unsupported_components).
     out.votes.assign(out.vertex_pos.size(), 0);
     if (out.vertex_pos.empty()) return;
-    for (uint32_t p : near) {
-        const Eigen::Vector3d q = f.points().point(p);
+    for (size_t n = 0; n < near.size(); ++n) {
+        const Eigen::Vector3d q = f.points().point(near[n]);
         if (!(q.array() >= box.min().array()).all() || !(q.array() < box.max().array()).all()) continue;
         size_t best = 0;
         double best_d2 = INFINITY;
@@ -167,7 +200,7 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, int64_t block, 
             const double d2 = (out.vertex_pos[v] - q).squaredNorm();
             if (d2 < best_d2) best_d2 = d2, best = v;
         }
-        ++out.votes[best];
+        out.votes[best] += weight[n];
     }
 }
 

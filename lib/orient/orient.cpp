@@ -91,20 +91,23 @@ std::vector<float> point_normals(const MpuFunction &f, const PointSet &points, u
                                  Progress &progress, double done_before, double total) {
     const Octree &tree = f.tree();
     std::vector<float> out(3 * points.size());
-    // Walk leaves so each point knows its leaf for the fallback.
     std::vector<uint32_t> leaves;
     for (uint32_t i = 0; i < tree.cells.size(); ++i)
         if (tree.cells[i].is_leaf() && tree.cells[i].point_end > tree.cells[i].point_begin) leaves.push_back(i);
     parallel_for(0, leaves.size(), threads, progress, [&](size_t l) {
         const Cell &c = tree.cells[leaves[l]];
+        // The leaves blending inside this cell, gathered once for all its points.
+        thread_local std::vector<uint32_t> near;
+        const Eigen::Vector3d half = Eigen::Vector3d::Constant(0.5 * c.size);
+        f.gather(Eigen::AlignedBox3d(c.centre - half, c.centre + half), near);
         Eigen::Vector3d g;
         for (uint32_t k = c.point_begin; k < c.point_end; ++k) {
             uint32_t i = tree.order[k];
             Eigen::Vector3d p = points.point(i);
-            f.value(p, &g);
+            f.value_among(near, p, &g);
             double gn = g.norm();
             if (!(gn > 1e-12) || !g.allFinite()) {
-                c.value(p, tree.pieces, &g);
+                c.value(p, tree.pieces, &g);  // ∇f vanishes: the oriented local fit
                 gn = g.norm();
             }
             Eigen::Vector3d n = gn > 0.0 ? Eigen::Vector3d(-g / gn) : Eigen::Vector3d::UnitZ();

@@ -34,7 +34,7 @@ from typing import Dict, List, Optional, Sequence, Tuple
 ROOT = os.path.abspath(os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", ".."))
 TOLERANCE = 1e-9
 # Explicit, non-default values: a binding that drops a flag makes a different mesh.
-FLAGS = ["--error", "0.003", "--max-depth", "9", "--resolution", "56", "--threads", "2"]
+FLAGS = ["--error", "0.003", "--max-depth", "6", "--resolution", "56", "--threads", "2"]
 LANGUAGES = ["c", "python", "node", "rust"]
 TIMEOUT = 600  # seconds per program run (the Rust one may compile the crate first)
 

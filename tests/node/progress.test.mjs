@@ -89,6 +89,14 @@ test('an error thrown by the callback cancels the stage and is rethrown as is', 
     assert.throws(() => s.fit(xyz), (err) => err === boom);
     assert.equal(calls, 1);
     assert.throws(() => s.orient(), { code: 'GMPU_ERROR_WRONG_ORDER' }, 'the fit was cancelled');
+    // Thrown with the last report, when the stage has already completed: still rethrown
+    // (and the finished mesh freed, not handed out).
+    s.onProgress = null;
+    s.fit().orient();
+    s.onProgress = (stage, fraction) => {
+        if (stage === 'polygonize' && fraction === 1) throw boom;
+    };
+    assert.throws(() => s.polygonize(), (err) => err === boom);
     // Non-Error values are rethrown too.
     s.onProgress = () => {
         throw 'a string';

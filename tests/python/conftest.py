@@ -72,13 +72,16 @@ def oriented(small_cloud):
     s.close()
 
 
-def run_python(code: str, env_extra=None, cwd=None, timeout=120, **kw) -> subprocess.CompletedProcess:
-    """Runs code in a fresh /usr/bin/python3 that imports gmpu from this checkout."""
+def run_python(code: str, args=(), env_extra=None, cwd=None, timeout=120, pythonpath=True):
+    """Runs code (with sys.argv[1:] = args) in a fresh /usr/bin/python3 that imports gmpu
+    from this checkout (pythonpath=False: from wherever the interpreter finds it)."""
     env = dict(os.environ)
-    env["PYTHONPATH"] = str(BINDINGS)
+    env.pop("PYTHONPATH", None)
+    if pythonpath:
+        env["PYTHONPATH"] = str(BINDINGS)
     env.update(env_extra or {})
-    return subprocess.run([PYTHON, "-c", code], env=env, cwd=cwd or REPO, capture_output=True, text=True,
-                          timeout=timeout, **kw)
+    return subprocess.run([PYTHON, "-c", code, *map(str, args)], env=env, cwd=cwd or REPO, capture_output=True,
+                          text=True, timeout=timeout)
 
 
 def rss_bytes() -> int:

@@ -104,10 +104,8 @@ fn run(o: &Options) -> Result<(), String> {
     let mesh = surface.polygonize().map_err(fail("polygonize failed"))?;
     mesh.write(output).map_err(fail("cannot write mesh"))?;
     if let Some(path) = &o.normals_out {
-        let written = surface
-            .normals()
-            .and_then(|n| Points::new(cloud.positions(), Some(&n)))
-            .and_then(|p| p.write(path));
+        let written =
+            surface.normals().and_then(|n| Points::new(cloud.positions(), Some(&n))).and_then(|p| p.write(path));
         if let Err(e) = written {
             let _ = std::fs::remove_file(output); // all or nothing, as the C CLI
             return Err(format!("cannot write oriented points: {e}"));

@@ -34,8 +34,8 @@
 //!
 //! # Errors
 //! Every fallible call returns [`Result`]; an [`Error`] carries the C status as a
-//! [`Status`] and the C library's message (`"GMPU_ERROR_INVALID_INPUT: point 17 is NaN or
-//! infinite"`). A few errors are raised by the binding itself before calling C, where a
+//! [`Status`] and the C library's message (`"GMPU_ERROR_INVALID_INPUT: point 17 has a NaN
+//! or infinite coordinate"`). A few errors are raised by the binding itself before calling C, where a
 //! Rust slice cannot express what C would be asked (mismatched lengths, a stride of 0, a
 //! path with a NUL byte); they use the same statuses and message format.
 //!
@@ -375,11 +375,9 @@ mod sealed {
 /// `f64` or `f32`: the coordinate types the C library takes points and normals in.
 pub trait Real: Copy + sealed::Sealed + 'static {
     #[doc(hidden)]
-    unsafe fn set_points(s: *mut sys::gmpu_surface, p: *const Self, count: usize, stride: usize)
-        -> sys::gmpu_status;
+    unsafe fn set_points(s: *mut sys::gmpu_surface, p: *const Self, count: usize, stride: usize) -> sys::gmpu_status;
     #[doc(hidden)]
-    unsafe fn set_normals(s: *mut sys::gmpu_surface, p: *const Self, count: usize, stride: usize)
-        -> sys::gmpu_status;
+    unsafe fn set_normals(s: *mut sys::gmpu_surface, p: *const Self, count: usize, stride: usize) -> sys::gmpu_status;
 }
 
 impl Real for f64 {
@@ -437,9 +435,7 @@ fn c_path(path: &Path) -> Result<CString> {
     #[cfg(not(unix))]
     let bytes = match path.to_str() {
         Some(s) => s.as_bytes().to_vec(),
-        None => {
-            return Err(Error::binding(Status::InvalidArgument, format_args!("path {path:?} is not UTF-8")))
-        }
+        None => return Err(Error::binding(Status::InvalidArgument, format_args!("path {path:?} is not UTF-8"))),
     };
     CString::new(bytes)
         .map_err(|_| Error::binding(Status::InvalidArgument, format_args!("path {path:?} contains a NUL byte")))
@@ -584,17 +580,20 @@ impl Surface {
     /// (replacing an earlier one). It is called on the thread making the call, at least
     /// every 50 ms, with the stage and a fraction in [0, 1]; returning
     /// [`ControlFlow::Break`] cancels the stage, which then fails with
-    /// [`Status::Cancelled`] within 100 ms. A panic in the callback cancels the stage too and
-    /// is resumed when the call returns.
+    /// [`Status::Cancelled`] within 100 ms, keeping the stages completed before. A panic in
+    /// the callback cancels the stage too and is resumed when the call returns; the closure
+    /// is not called again during that call.
+    ///
+    /// The report with fraction 1 comes when the stage's work is done: a `Break` (or panic)
+    /// there is too late to cancel, and the call succeeds (the panic is still resumed).
     pub fn set_progress<F>(&mut self, callback: F) -> Result<()>
     where
         F: FnMut(Stage, f64) -> ControlFlow<()> + Send + 'static,
     {
         let state = Box::into_raw(Box::new(ProgressState { callback: Box::new(callback), panic: None }));
         // SAFETY: valid handle; state stays alive until replaced or the surface is dropped.
-        let status = unsafe {
-            sys::gmpu_surface_set_progress(self.raw.as_ptr(), Some(progress_trampoline), state.cast())
-        };
+        let status =
+            unsafe { sys::gmpu_surface_set_progress(self.raw.as_ptr(), Some(progress_trampoline), state.cast()) };
         if let Err(e) = check(status) {
             // SAFETY: not registered, still ours.
             drop(unsafe { Box::from_raw(state) });

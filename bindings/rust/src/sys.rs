@@ -160,14 +160,10 @@ c_enums! {
 
 /// `typedef int (*gmpu_progress_fn)(void *user, gmpu_stage stage, double fraction);`
 /// (nullable, hence the `Option`).
-pub type gmpu_progress_fn =
-    Option<unsafe extern "C" fn(user: *mut c_void, stage: gmpu_stage, fraction: f64) -> c_int>;
+pub type gmpu_progress_fn = Option<unsafe extern "C" fn(user: *mut c_void, stage: gmpu_stage, fraction: f64) -> c_int>;
 /// The parameter and return types of [`gmpu_progress_fn`], for the header test.
-pub const PROGRESS_FN: Signature = Signature {
-    name: "gmpu_progress_fn",
-    params: &["*mut c_void", "gmpu_stage", "f64"],
-    ret: "c_int",
-};
+pub const PROGRESS_FN: Signature =
+    Signature { name: "gmpu_progress_fn", params: &["*mut c_void", "gmpu_stage", "f64"], ret: "c_int" };
 
 c_functions! {
     pub fn gmpu_status_name(status: gmpu_status) -> *const c_char;

@@ -38,7 +38,7 @@ fn strip_comments(text: &str) -> String {
         let block = rest.find("/*");
         let line = rest.find("//");
         match (block, line) {
-            (Some(b), l) if l.is_none_or(|l| b < l) => {
+            (Some(b), l) if l.map_or(true, |l| b < l) => {
                 out.push_str(&rest[..b]);
                 let end = rest[b + 2..].find("*/").expect("unterminated comment in header");
                 out.push(' ');
@@ -327,7 +327,8 @@ fn differences(header_text: &str) -> Vec<String> {
     let check_safe = |diffs: &mut Vec<String>, prefix: &str, c_enum: &str, safe: Vec<(String, u32)>| {
         let mut want = header_enum(c_enum);
         want.retain(|(n, _)| n != "GMPU_OK");
-        let got: Vec<(String, u32)> = safe.into_iter().map(|(n, v)| (format!("{prefix}{}", screaming(&n)), v)).collect();
+        let got: Vec<(String, u32)> =
+            safe.into_iter().map(|(n, v)| (format!("{prefix}{}", screaming(&n)), v)).collect();
         if got != want {
             diffs.push(format!("safe enum for {c_enum}: header {want:?}, binding {got:?}"));
         }
@@ -408,14 +409,26 @@ fn drift_is_detected() {
         ("GMPU_PARAM_NOISE_SCALE = 11", "GMPU_PARAM_NOISE_SCALE = 11,\n    GMPU_PARAM_NEW = 12"),
         ("GMPU_STAGE_POLYGONIZE = 3", "GMPU_STAGE_POLYGONIZE = 3, GMPU_STAGE_EXTRA = 4"),
         ("GMPU_ERROR_INTERNAL = 11", "GMPU_ERROR_INTERNAL = 11, GMPU_ERROR_NEW = 12"),
-        ("const double *xyz,\n                                                 size_t count", "const float *xyz,\n                                                 size_t count"),
+        (
+            "const double *xyz,\n                                                 size_t count",
+            "const float *xyz,\n                                                 size_t count",
+        ),
         ("gmpu_surface_point_count(const gmpu_surface *surface)", "gmpu_surface_point_count(gmpu_surface *surface)"),
         ("GMPU_API uint32_t gmpu_abi_version(void);", "GMPU_API uint64_t gmpu_abi_version(void);"),
-        ("GMPU_API uint32_t gmpu_abi_version(void);", "GMPU_API uint32_t gmpu_abi_version(void);\nGMPU_API int gmpu_new(void);"),
+        (
+            "GMPU_API uint32_t gmpu_abi_version(void);",
+            "GMPU_API uint32_t gmpu_abi_version(void);\nGMPU_API int gmpu_new(void);",
+        ),
         ("GMPU_API uint32_t gmpu_abi_version(void);", ""),
-        ("size_t count, size_t stride);\nGMPU_API gmpu_status gmpu_surface_set_points_f32", "size_t stride, size_t count);\nGMPU_API gmpu_status gmpu_surface_set_points_f32"),
+        (
+            "size_t count, size_t stride);\nGMPU_API gmpu_status gmpu_surface_set_points_f32",
+            "size_t stride, size_t count);\nGMPU_API gmpu_status gmpu_surface_set_points_f32",
+        ),
         ("(void *user, gmpu_stage stage, double fraction)", "(void *user, gmpu_stage stage, float fraction)"),
-        ("typedef struct gmpu_points gmpu_points;", "typedef struct gmpu_points gmpu_points;\ntypedef struct gmpu_octree gmpu_octree;"),
+        (
+            "typedef struct gmpu_points gmpu_points;",
+            "typedef struct gmpu_points gmpu_points;\ntypedef struct gmpu_octree gmpu_octree;",
+        ),
         ("#define GMPU_ABI_VERSION 1", "#define GMPU_ABI_VERSION 2"),
     ];
     for (from, to) in edits {

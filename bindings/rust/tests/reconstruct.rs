@@ -37,11 +37,13 @@ fn bunny_sample_is_watertight_outward_and_correctly_oriented() {
         assert!((dot(*n, *n) - 1.0).abs() < 1e-5, "not unit: {n:?}");
     }
     let acc = orientation_accuracy(&normals, gt.normals().unwrap());
+    eprintln!("bunny_clean orientation accuracy {:.4}%", 100.0 * acc);
     assert!(acc >= 0.995, "orientation accuracy {:.4} < 0.995", acc);
 
     // The mesh at the default (automatic) resolution.
     let mesh = s.polygonize().unwrap();
     check_watertight(mesh.vertices(), mesh.triangles()).unwrap();
+    eprintln!("bunny mesh {} vertices, {} triangles, watertight", mesh.vertex_count(), mesh.triangle_count());
     assert!(signed_volume(mesh.vertices(), mesh.triangles()) > 0.0, "mesh is inside out");
     assert!(mesh.triangle_count() > 10_000);
     assert_eq!(mesh.normals().unwrap().len(), mesh.vertex_count());
@@ -195,8 +197,8 @@ fn files_round_trip() {
 
 #[test]
 fn reconstruct_convenience_and_version() {
-    let mesh = gmpu::reconstruct(&sphere(1000, [0.0; 3], 1.0), &[(Param::Resolution, 16.0), (Param::Threads, 1.0)])
-        .unwrap();
+    let mesh =
+        gmpu::reconstruct(&sphere(1000, [0.0; 3], 1.0), &[(Param::Resolution, 16.0), (Param::Threads, 1.0)]).unwrap();
     check_watertight(mesh.vertices(), mesh.triangles()).unwrap();
     assert_eq!(gmpu::abi_version(), gmpu::sys::GMPU_ABI_VERSION);
     assert_eq!(gmpu::version_number(), gmpu::sys::GMPU_VERSION_NUMBER);

@@ -19,11 +19,7 @@ pub fn shared_data() -> PathBuf {
         Some(d) => PathBuf::from(d),
         None => repo_root().join("../shared/data"),
     };
-    assert!(
-        dir.join("clouds").is_dir(),
-        "shared test data not found at {} (set GMPU_SHARED_DATA)",
-        dir.display()
-    );
+    assert!(dir.join("clouds").is_dir(), "shared test data not found at {} (set GMPU_SHARED_DATA)", dir.display());
     dir
 }
 
