@@ -56,6 +56,7 @@ test-c: build
 	meson test -C $(BUILD) --print-errorlogs
 
 test-python: build
+	$(PYTHON) -m pytest tests/python -q -p no:cacheprovider --basetemp=$(BUILD)/pytest-python
 
 test-node: build
 	cd bindings/node && npm ci --no-audit --no-fund --loglevel=error

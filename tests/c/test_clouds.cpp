@@ -1,7 +1,8 @@
 // The shared data's clouds (../shared/data/clouds, every one found there): the issue's
 // acceptance numbers, asserted. Orientation accuracy against the ground-truth outward
 // normals (no global flip allowed), a watertight mesh with one component per connected
-// shape (as many as the ground-truth mesh has), and exact distances to the ground truth.
+// shape (as many as the ground-truth mesh has, each of the same genus), and exact distances
+// to the ground truth.
 #include <dirent.h>
 
 #include <algorithm>
@@ -61,6 +62,12 @@ Meta read_meta(const std::string &path) {
     return m;
 }
 
+std::string join(const std::vector<int> &v) {
+    std::string s;
+    for (int x : v) s += (s.empty() ? "" : ",") + std::to_string(x);
+    return s;
+}
+
 std::vector<std::string> cloud_names() {
     std::vector<std::string> names;
     DIR *dir = opendir(shared_data("clouds").c_str());
@@ -95,11 +102,17 @@ void every_cloud(void **) {
         const double orientation = orientation_accuracy(r.normals, gt.normals).accuracy;
         const MeshCheck check = check_mesh(r.mesh);
         size_t expected_components = 1;  // scans without a ground-truth mesh: one object
+        std::vector<int> expected_genus, genus;
+        for (const auto &c : check.component_reports) genus.push_back(c.genus);
+        std::sort(genus.begin(), genus.end());
         SurfaceComparison cmp;
         const bool scored = meta.present && !meta.mesh.empty();
         if (scored) {
             TriangleMesh truth = load_mesh(shared_data("meshes/" + meta.mesh));
-            expected_components = check_mesh(truth).components;
+            const MeshCheck truth_check = check_mesh(truth);
+            expected_components = truth_check.components;
+            for (const auto &c : truth_check.component_reports) expected_genus.push_back(c.genus);
+            std::sort(expected_genus.begin(), expected_genus.end());
             ComparisonOptions opt;
             opt.samples = 30000;
             cmp = compare_surfaces(r.mesh, truth, opt);
@@ -110,9 +123,12 @@ void every_cloud(void **) {
         const double max_chamfer = noisy ? 0.004 : 0.0025, min_f1 = noisy ? 0.98 : 0.99;
         bool ok = orientation >= min_orientation && check.watertight && check.nonmanifold_vertices == 0 &&
                   check.components == expected_components;
-        if (scored) ok = ok && cmp.chamfer_l1 <= max_chamfer && cmp.fscore_at(0.01)->fscore >= min_f1;
-        fprintf(stderr, "%-20s %s orientation %.3f%%  watertight %d  components %zu/%zu", name.c_str(),
-                ok ? "ok  " : "FAIL", 100 * orientation, int(check.watertight), check.components, expected_components);
+        // Topology too: the same handles as the ground truth, component by component.
+        if (scored) ok = ok && genus == expected_genus && cmp.chamfer_l1 <= max_chamfer &&
+                         cmp.fscore_at(0.01)->fscore >= min_f1;
+        fprintf(stderr, "%-20s %s orientation %.3f%%  watertight %d  components %zu/%zu  genus %s/%s", name.c_str(),
+                ok ? "ok  " : "FAIL", 100 * orientation, int(check.watertight), check.components, expected_components,
+                join(genus).c_str(), scored ? join(expected_genus).c_str() : "?");
         if (scored)
             fprintf(stderr, "  chamfer %.4f%%  F@0.5%% %.4f  F@1%% %.4f", 100 * cmp.chamfer_l1,
                     cmp.fscore_at(0.005)->fscore, cmp.fscore_at(0.01)->fscore);

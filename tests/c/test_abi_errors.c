@@ -1,0 +1,620 @@
+/* Misuse and bad input through the surface half of the C ABI, from C: NULL handles and
+ * buffers for every function, calls in the wrong order, too few / identical / collinear /
+ * coplanar / non-finite points, bad strides, counts and parameters, and coordinates at
+ * 1e±30. Every failure must give its documented status, a message naming the problem, leave
+ * outputs untouched and the handle usable: each test ends with a full reconstruction on the
+ * handle it abused. (Readers and the points/mesh functions: test_io.cpp, test_io_abi.c.) */
+#define _GNU_SOURCE
+#include <float.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "gmpu/gmpu.h"
+#include "robust_util.h"
+
+#define N_GOOD 2000
+static const double kCentre[3] = {0.3, -0.2, 0.5};
+static double *g_good; /* N_GOOD points on the unit sphere around kCentre */
+
+static int setup(void **state) {
+    (void)state;
+    g_good = robust_sphere(N_GOOD, kCentre, 1.0, 1);
+    return g_good ? 0 : -1;
+}
+
+static int teardown(void **state) {
+    (void)state;
+    free(g_good);
+    return 0;
+}
+
+static gmpu_surface *new_surface(void) {
+    gmpu_surface *s = NULL;
+    assert_ok(gmpu_surface_create(&s));
+    assert_non_null(s);
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_RESOLUTION, 24)); /* quick polygonize */
+    return s;
+}
+
+/* The handle still works after whatever the test did to it: a full reconstruction of the
+ * good sphere gives a closed outward mesh, and evaluate is positive at the centre. */
+static void check_usable_and_destroy(gmpu_surface *s) {
+    gmpu_mesh *m = robust_reconstruct(s, g_good, N_GOOD);
+    const char *problem = robust_mesh_problem(m);
+    if (problem) fail_msg("mesh after misuse: %s", problem);
+    assert_true(robust_signed_volume(m) > 3.0); /* 4π/3 ≈ 4.19 */
+    double f = 0;
+    assert_ok(gmpu_surface_evaluate(s, kCentre, 1, &f, NULL));
+    assert_true(f > 0.5);
+    gmpu_mesh_destroy(m);
+    gmpu_surface_destroy(s);
+}
+
+static void test_null_handles_and_buffers(void **state) {
+    (void)state;
+    gmpu_surface *s = NULL;
+    check_failure(gmpu_surface_create(NULL), GMPU_ERROR_INVALID_ARGUMENT, "out is NULL");
+    gmpu_surface_destroy(NULL); /* a no-op */
+    assert_string_equal(gmpu_surface_last_error(NULL), "");
+    assert_int_equal(gmpu_surface_point_count(NULL), 0);
+
+    double v = 42;
+    check_failure(gmpu_surface_set_param(NULL, GMPU_PARAM_ERROR, 0.01), GMPU_ERROR_INVALID_ARGUMENT, "surface is NULL");
+    check_failure(gmpu_surface_get_param(NULL, GMPU_PARAM_ERROR, &v), GMPU_ERROR_INVALID_ARGUMENT, "surface is NULL");
+    check_failure(gmpu_surface_get_stat(NULL, GMPU_STAT_POINTS, &v), GMPU_ERROR_INVALID_ARGUMENT, "surface is NULL");
+    assert_true(v == 42);
+    check_failure(gmpu_surface_set_progress(NULL, NULL, NULL), GMPU_ERROR_INVALID_ARGUMENT, "surface is NULL");
+    check_failure(gmpu_surface_set_points_f64(NULL, g_good, N_GOOD, 0), GMPU_ERROR_INVALID_ARGUMENT, "surface is NULL");
+    float fp[3] = {0, 0, 0};
+    check_failure(gmpu_surface_set_points_f32(NULL, fp, 1, 0), GMPU_ERROR_INVALID_ARGUMENT, "surface is NULL");
+    check_failure(gmpu_surface_set_normals_f64(NULL, g_good, N_GOOD, 0), GMPU_ERROR_INVALID_ARGUMENT, "surface is NULL");
+    check_failure(gmpu_surface_set_normals_f32(NULL, fp, 1, 0), GMPU_ERROR_INVALID_ARGUMENT, "surface is NULL");
+    check_failure(gmpu_surface_fit(NULL), GMPU_ERROR_INVALID_ARGUMENT, "surface is NULL");
+    check_failure(gmpu_surface_orient(NULL), GMPU_ERROR_INVALID_ARGUMENT, "surface is NULL");
+    double q[3] = {0, 0, 0}, val = 7, grad[3] = {7, 7, 7};
+    check_failure(gmpu_surface_evaluate(NULL, q, 1, &val, grad), GMPU_ERROR_INVALID_ARGUMENT, "surface is NULL");
+    check_failure(gmpu_surface_copy_normals(NULL, grad, 1), GMPU_ERROR_INVALID_ARGUMENT, "surface is NULL");
+    gmpu_mesh *m = (gmpu_mesh *)&m; /* garbage that must not be freed nor kept */
+    check_failure(gmpu_surface_polygonize(NULL, &m), GMPU_ERROR_INVALID_ARGUMENT, "surface is NULL");
+    check_failure(gmpu_mesh_write(NULL, "x.ply"), GMPU_ERROR_INVALID_ARGUMENT, "mesh is NULL");
+
+    /* NULL buffers on a real surface, at every stage; each leaves the handle as it was. */
+    s = new_surface();
+    check_failure(gmpu_surface_get_param(s, GMPU_PARAM_ERROR, NULL), GMPU_ERROR_INVALID_ARGUMENT, "value is NULL");
+    check_failure(gmpu_surface_get_stat(s, GMPU_STAT_POINTS, NULL), GMPU_ERROR_INVALID_ARGUMENT, "value is NULL");
+    check_failure(gmpu_surface_set_points_f64(s, NULL, N_GOOD, 0), GMPU_ERROR_INVALID_ARGUMENT, "xyz is NULL");
+    check_failure(gmpu_surface_set_points_f32(s, NULL, N_GOOD, 0), GMPU_ERROR_INVALID_ARGUMENT, "xyz is NULL");
+    check_failure(gmpu_surface_set_points_f64(s, NULL, 0, 0), GMPU_ERROR_INVALID_ARGUMENT, "xyz is NULL");
+    assert_int_equal(gmpu_surface_point_count(s), 0);
+    check_failure(gmpu_surface_polygonize(s, NULL), GMPU_ERROR_INVALID_ARGUMENT, "out is NULL");
+
+    gmpu_mesh *mesh = robust_reconstruct(s, g_good, N_GOOD);
+    gmpu_mesh_destroy(mesh);
+    check_failure(gmpu_surface_set_normals_f64(s, NULL, N_GOOD, 0), GMPU_ERROR_INVALID_ARGUMENT, "nxyz is NULL");
+    check_failure(gmpu_surface_set_normals_f32(s, NULL, N_GOOD, 0), GMPU_ERROR_INVALID_ARGUMENT, "nxyz is NULL");
+    check_failure(gmpu_surface_evaluate(s, NULL, 1, &val, grad), GMPU_ERROR_INVALID_ARGUMENT, "xyz is NULL");
+    check_failure(gmpu_surface_evaluate(s, q, 1, NULL, NULL), GMPU_ERROR_INVALID_ARGUMENT,
+                  "values and gradients are both NULL");
+    assert_true(val == 7 && grad[0] == 7 && grad[1] == 7 && grad[2] == 7); /* untouched */
+    check_failure(gmpu_surface_copy_normals(s, NULL, N_GOOD), GMPU_ERROR_INVALID_ARGUMENT, "out is NULL");
+    check_failure(gmpu_surface_polygonize(s, NULL), GMPU_ERROR_INVALID_ARGUMENT, "out is NULL");
+    /* The failures above did not drop the orientation: const calls still work. */
+    assert_ok(gmpu_surface_evaluate(s, kCentre, 1, &val, NULL));
+    assert_true(val > 0.5);
+    /* count 0 needs no buffer content. */
+    assert_ok(gmpu_surface_evaluate(s, q, 0, &val, NULL));
+    /* gmpu_surface_set_progress(s, NULL, ...) removes the callback: not an error. */
+    assert_ok(gmpu_surface_set_progress(s, NULL, NULL));
+    check_usable_and_destroy(s);
+}
+
+static void test_wrong_order(void **state) {
+    (void)state;
+    gmpu_surface *s = new_surface();
+    double q[3] = {0, 0, 0}, val = 7, n[3 * N_GOOD];
+    gmpu_mesh *m = (gmpu_mesh *)&m;
+
+    /* Nothing set. */
+    check_failure2(gmpu_surface_fit(s), GMPU_ERROR_WRONG_ORDER, "gmpu_surface_fit", "gmpu_surface_set_points");
+    assert_non_null(strstr(gmpu_surface_last_error(s), "GMPU_ERROR_WRONG_ORDER"));
+    check_failure2(gmpu_surface_orient(s), GMPU_ERROR_WRONG_ORDER, "gmpu_surface_orient", "gmpu_surface_fit");
+    check_failure2(gmpu_surface_polygonize(s, &m), GMPU_ERROR_WRONG_ORDER, "gmpu_surface_polygonize",
+                   "gmpu_surface_orient");
+    assert_null(m); /* *out is NULL on failure */
+    check_failure2(gmpu_surface_evaluate(s, q, 1, &val, NULL), GMPU_ERROR_WRONG_ORDER, "gmpu_surface_evaluate",
+                   "gmpu_surface_orient");
+    assert_true(val == 7);
+    check_failure(gmpu_surface_copy_normals(s, n, 0), GMPU_ERROR_WRONG_ORDER, "gmpu_surface_orient");
+    check_failure2(gmpu_surface_set_normals_f64(s, g_good, N_GOOD, 0), GMPU_ERROR_WRONG_ORDER,
+                   "gmpu_surface_set_normals", "gmpu_surface_set_points");
+    double stat = -1;
+    assert_ok(gmpu_surface_get_stat(s, GMPU_STAT_CELLS, &stat));
+    assert_true(stat == 0); /* 0 before the stage ran */
+
+    /* Points only. */
+    assert_ok(gmpu_surface_set_points_f64(s, g_good, N_GOOD, 0));
+    check_failure(gmpu_surface_orient(s), GMPU_ERROR_WRONG_ORDER, "gmpu_surface_fit");
+    check_failure(gmpu_surface_polygonize(s, &m), GMPU_ERROR_WRONG_ORDER, "gmpu_surface_orient");
+    check_failure(gmpu_surface_evaluate(s, q, 1, &val, NULL), GMPU_ERROR_WRONG_ORDER, "gmpu_surface_orient");
+    check_failure(gmpu_surface_copy_normals(s, n, N_GOOD), GMPU_ERROR_WRONG_ORDER, "gmpu_surface_orient");
+
+    /* Fitted only. */
+    assert_ok(gmpu_surface_fit(s));
+    check_failure(gmpu_surface_polygonize(s, &m), GMPU_ERROR_WRONG_ORDER, "gmpu_surface_orient");
+    assert_null(m);
+    check_failure(gmpu_surface_evaluate(s, q, 1, &val, NULL), GMPU_ERROR_WRONG_ORDER, "gmpu_surface_orient");
+
+    /* Oriented, then a parameter that discards the fit: back to "needs fit". */
+    assert_ok(gmpu_surface_orient(s));
+    assert_ok(gmpu_surface_evaluate(s, q, 1, &val, NULL));
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_RESOLUTION, 32)); /* does not refit */
+    assert_ok(gmpu_surface_evaluate(s, q, 1, &val, NULL));
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_ERROR, 0.003)); /* refits */
+    check_failure(gmpu_surface_evaluate(s, q, 1, &val, NULL), GMPU_ERROR_WRONG_ORDER, "gmpu_surface_orient");
+    check_failure(gmpu_surface_orient(s), GMPU_ERROR_WRONG_ORDER, "gmpu_surface_fit");
+
+    /* New points discard fit and orientation. */
+    assert_ok(gmpu_surface_fit(s));
+    assert_ok(gmpu_surface_orient(s));
+    assert_ok(gmpu_surface_set_points_f64(s, g_good, N_GOOD, 0));
+    check_failure(gmpu_surface_orient(s), GMPU_ERROR_WRONG_ORDER, "gmpu_surface_fit");
+
+    /* Normals after orient discard the orientation only. */
+    assert_ok(gmpu_surface_fit(s));
+    assert_ok(gmpu_surface_orient(s));
+    for (size_t i = 0; i < N_GOOD; ++i)
+        for (int k = 0; k < 3; ++k) n[3 * i + k] = g_good[3 * i + k] - kCentre[k];
+    assert_ok(gmpu_surface_set_normals_f64(s, n, N_GOOD, 0));
+    check_failure(gmpu_surface_evaluate(s, q, 1, &val, NULL), GMPU_ERROR_WRONG_ORDER, "gmpu_surface_orient");
+    assert_ok(gmpu_surface_orient(s));
+    assert_ok(gmpu_surface_evaluate(s, kCentre, 1, &val, NULL));
+    assert_true(val > 0.5);
+    check_usable_and_destroy(s);
+}
+
+/* A set_points failure keeps the previous points and the stages built on them. */
+static void check_rejected_keeps_state(gmpu_surface *s) {
+    assert_int_equal(gmpu_surface_point_count(s), N_GOOD);
+    double f = 0;
+    assert_ok(gmpu_surface_evaluate(s, kCentre, 1, &f, NULL));
+    assert_true(f > 0.5);
+}
+
+static gmpu_surface *oriented_surface(void) {
+    gmpu_surface *s = new_surface();
+    assert_ok(gmpu_surface_set_points_f64(s, g_good, N_GOOD, 0));
+    assert_ok(gmpu_surface_fit(s));
+    assert_ok(gmpu_surface_orient(s));
+    return s;
+}
+
+static void test_too_few_points(void **state) {
+    (void)state;
+    gmpu_surface *s = oriented_surface();
+    const char *last_error_before = NULL;
+    (void)last_error_before;
+    /* 0 to 3 points (and up to the minimum of 15): too few, with the count and the minimum. */
+    for (size_t n = 0; n <= 14; n = n < 3 ? n + 1 : n + 11) {
+        char needle[64];
+        snprintf(needle, sizeof needle, "%zu points given; at least 15", n);
+        check_failure(gmpu_surface_set_points_f64(s, g_good, n, 0), GMPU_ERROR_INVALID_INPUT, needle);
+        assert_non_null(strstr(gmpu_surface_last_error(s), needle)); /* the handle's copy too */
+        float f32[3 * 14];
+        for (size_t i = 0; i < 3 * n; ++i) f32[i] = (float)g_good[i];
+        check_failure(gmpu_surface_set_points_f32(s, f32, n, 0), GMPU_ERROR_INVALID_INPUT, needle);
+        check_rejected_keeps_state(s);
+    }
+    /* The minimum follows GMPU_PARAM_MIN_POINTS (this discards the fit). */
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_MIN_POINTS, 6));
+    check_failure(gmpu_surface_set_points_f64(s, g_good, 5, 0), GMPU_ERROR_INVALID_INPUT, "at least 6");
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_MIN_POINTS, 15));
+    check_usable_and_destroy(s);
+}
+
+/* Clouds just above the minimum: a clean error or a closed mesh, never a crash. */
+static void test_tiny_clouds(void **state) {
+    (void)state;
+    const size_t sizes[] = {15, 16, 20, 30, 60};
+    for (size_t k = 0; k < sizeof sizes / sizeof *sizes; ++k) {
+        gmpu_surface *s = new_surface();
+        assert_ok(gmpu_surface_set_points_f64(s, g_good, sizes[k], 0));
+        gmpu_mesh *m = NULL;
+        gmpu_status st = gmpu_surface_fit(s);
+        if (st == GMPU_OK) st = gmpu_surface_orient(s);
+        if (st == GMPU_OK) st = gmpu_surface_polygonize(s, &m);
+        if (st == GMPU_OK) {
+            const char *problem = robust_mesh_problem(m);
+            if (problem) fail_msg("%zu points: %s", sizes[k], problem);
+        } else {
+            assert_null(m);
+            assert_true(strlen(gmpu_last_error()) > strlen(gmpu_status_name(st)) + 4);
+            assert_true(st != GMPU_ERROR_INTERNAL);
+        }
+        gmpu_mesh_destroy(m);
+        gmpu_surface_destroy(s);
+    }
+}
+
+static void test_degenerate_clouds(void **state) {
+    (void)state;
+    gmpu_surface *s = oriented_surface();
+    enum { N = 500 };
+    double p[3 * N];
+    float p32[3 * N];
+    robust_rng rng = {99};
+
+    /* All identical, also at 1e300 and 1e-300, and identical to 12 digits. */
+    const double where[][3] = {{1, 2, 3}, {0, 0, 0}, {-1e300, 1e300, 5e299}, {1e-300, -1e-300, 0}};
+    for (size_t w = 0; w < 4; ++w) {
+        for (size_t i = 0; i < N; ++i)
+            for (int k = 0; k < 3; ++k) p[3 * i + k] = where[w][k];
+        check_failure(gmpu_surface_set_points_f64(s, p, N, 0), GMPU_ERROR_DEGENERATE_INPUT, "identical");
+        check_rejected_keeps_state(s);
+    }
+    for (size_t i = 0; i < N; ++i)
+        for (int k = 0; k < 3; ++k) p[3 * i + k] = 1e6 * (k + 1) * (1 + 1e-15 * robust_uniform(&rng));
+    check_failure(gmpu_surface_set_points_f64(s, p, N, 0), GMPU_ERROR_DEGENERATE_INPUT, "identical");
+    for (size_t i = 0; i < 3 * N; ++i) p32[i] = 2.5f;
+    check_failure(gmpu_surface_set_points_f32(s, p32, N, 0), GMPU_ERROR_DEGENERATE_INPUT, "identical");
+
+    /* Collinear: on a line in a general direction, with repeats, at two scales. */
+    for (int scale = 0; scale < 2; ++scale) {
+        double unit = scale ? 1e20 : 1.0;
+        for (size_t i = 0; i < N; ++i) {
+            double t = floor(50 * robust_uniform(&rng)) / 7.0; /* many repeated points */
+            p[3 * i] = unit * (1 + 1 * t), p[3 * i + 1] = unit * (2 - 2 * t), p[3 * i + 2] = unit * (3 + 0.5 * t);
+        }
+        check_failure(gmpu_surface_set_points_f64(s, p, N, 0), GMPU_ERROR_DEGENERATE_INPUT, "collinear");
+        check_rejected_keeps_state(s);
+    }
+    /* Two distinct points repeated: collinear too. */
+    for (size_t i = 0; i < N; ++i)
+        for (int k = 0; k < 3; ++k) p[3 * i + k] = (i & 1) ? k : -k;
+    check_failure(gmpu_surface_set_points_f64(s, p, N, 0), GMPU_ERROR_DEGENERATE_INPUT, "collinear");
+
+    /* Coplanar: a tilted square patch (plane x + 2y - z = 1), f64 and f32; also a flat disk of
+     * points in z = 0 with repeats. No closed surface exists: the message says so. */
+    for (size_t i = 0; i < N; ++i) {
+        double a = robust_uniform(&rng), b = robust_uniform(&rng);
+        p[3 * i] = a, p[3 * i + 1] = b, p[3 * i + 2] = a + 2 * b - 1;
+        for (int k = 0; k < 3; ++k) p32[3 * i + k] = (float)p[3 * i + k];
+    }
+    check_failure2(gmpu_surface_set_points_f64(s, p, N, 0), GMPU_ERROR_DEGENERATE_INPUT, "coplanar",
+                   "no closed surface");
+    check_failure2(gmpu_surface_set_points_f32(s, p32, N, 0), GMPU_ERROR_DEGENERATE_INPUT, "coplanar",
+                   "no closed surface");
+    for (size_t i = 0; i < N; ++i) {
+        double r = floor(10 * robust_uniform(&rng)) / 10, t = 2 * M_PI * robust_uniform(&rng);
+        p[3 * i] = 1e-30 * r * cos(t), p[3 * i + 1] = 1e-30 * r * sin(t), p[3 * i + 2] = 0;
+    }
+    check_failure(gmpu_surface_set_points_f64(s, p, N, 0), GMPU_ERROR_DEGENERATE_INPUT, "coplanar");
+    check_rejected_keeps_state(s);
+    check_usable_and_destroy(s);
+}
+
+static void test_nonfinite_points(void **state) {
+    (void)state;
+    gmpu_surface *s = oriented_surface();
+    double *p = malloc(3 * N_GOOD * sizeof *p);
+    float *p32 = malloc(3 * N_GOOD * sizeof *p32);
+    const double bad[] = {NAN, INFINITY, -INFINITY};
+    /* Position of the first bad value: (point, coordinate); a second bad value comes later. */
+    const size_t at[][2] = {{0, 0}, {37, 1}, {N_GOOD - 1, 2}, {1234, 2}};
+    for (size_t b = 0; b < 3; ++b)
+        for (size_t a = 0; a < 4; ++a) {
+            memcpy(p, g_good, 3 * N_GOOD * sizeof *p);
+            p[3 * at[a][0] + at[a][1]] = bad[b];
+            if (at[a][0] + 5 < N_GOOD) p[3 * (at[a][0] + 5)] = NAN;
+            for (size_t i = 0; i < 3 * N_GOOD; ++i) p32[i] = (float)p[i];
+            char needle[64];
+            snprintf(needle, sizeof needle, "point %zu has a NaN or infinite coordinate", at[a][0]);
+            check_failure(gmpu_surface_set_points_f64(s, p, N_GOOD, 0), GMPU_ERROR_INVALID_INPUT, needle);
+            check_failure(gmpu_surface_set_points_f32(s, p32, N_GOOD, 0), GMPU_ERROR_INVALID_INPUT, needle);
+            check_rejected_keeps_state(s);
+        }
+    /* A double finite but beyond float: the f64 entry point copes (it normalises first). */
+    memcpy(p, g_good, 3 * N_GOOD * sizeof *p);
+    for (size_t i = 0; i < 3 * N_GOOD; ++i) p[i] *= 1e300;
+    assert_ok(gmpu_surface_set_points_f64(s, p, N_GOOD, 0));
+    free(p);
+    free(p32);
+    check_usable_and_destroy(s);
+}
+
+static void test_strides_and_counts(void **state) {
+    (void)state;
+    gmpu_surface *s = new_surface();
+    check_failure(gmpu_surface_set_points_f64(s, g_good, N_GOOD, 16), GMPU_ERROR_INVALID_ARGUMENT,
+                  "stride 16 is smaller than one point (24 bytes)");
+    float f[3 * 20] = {0};
+    check_failure(gmpu_surface_set_points_f32(s, f, 20, 8), GMPU_ERROR_INVALID_ARGUMENT,
+                  "stride 8 is smaller than one point (12 bytes)");
+    check_failure(gmpu_surface_set_points_f64(s, g_good, SIZE_MAX / 2, 0), GMPU_ERROR_INVALID_ARGUMENT, "too many points");
+    check_failure(gmpu_surface_set_points_f64(s, g_good, SIZE_MAX / 8, 24), GMPU_ERROR_INVALID_ARGUMENT, "too many points");
+    check_failure(gmpu_surface_set_points_f32(s, f, (size_t)1 << 62, 4096), GMPU_ERROR_INVALID_ARGUMENT, "too many points");
+    assert_int_equal(gmpu_surface_point_count(s), 0);
+
+    /* Interleaved records (x y z w, w = NaN garbage that must never be read), f64 and f32,
+     * give the same cloud as the packed array. */
+    double *rec = malloc(4 * N_GOOD * sizeof *rec);
+    float *rec32 = malloc(5 * N_GOOD * sizeof *rec32);
+    for (size_t i = 0; i < N_GOOD; ++i) {
+        for (int k = 0; k < 3; ++k) rec[4 * i + k] = g_good[3 * i + k], rec32[5 * i + k] = (float)g_good[3 * i + k];
+        rec[4 * i + 3] = NAN;
+        rec32[5 * i + 3] = rec32[5 * i + 4] = NAN;
+    }
+    double diag_packed = 0, diag = 0;
+    assert_ok(gmpu_surface_set_points_f64(s, g_good, N_GOOD, 0));
+    assert_ok(gmpu_surface_get_stat(s, GMPU_STAT_BBOX_DIAGONAL, &diag_packed));
+    assert_ok(gmpu_surface_set_points_f64(s, rec, N_GOOD, 4 * sizeof(double)));
+    assert_ok(gmpu_surface_get_stat(s, GMPU_STAT_BBOX_DIAGONAL, &diag));
+    assert_true(diag == diag_packed);
+    /* Unaligned stride (20 bytes for floats is fine; the header promises any stride ≥ a point). */
+    assert_ok(gmpu_surface_set_points_f32(s, rec32, N_GOOD, 5 * sizeof(float)));
+    assert_ok(gmpu_surface_get_stat(s, GMPU_STAT_BBOX_DIAGONAL, &diag));
+    assert_true(fabs(diag - diag_packed) < 1e-5 * diag_packed);
+    unsigned char *odd = malloc(N_GOOD * 25 + 1);
+    for (size_t i = 0; i < N_GOOD; ++i) memcpy(odd + 1 + 25 * i, g_good + 3 * i, 24);
+    assert_ok(gmpu_surface_set_points_f64(s, (const double *)(const void *)(odd + 1), N_GOOD, 25));
+    assert_ok(gmpu_surface_get_stat(s, GMPU_STAT_BBOX_DIAGONAL, &diag));
+    assert_true(diag == diag_packed);
+    free(odd);
+    free(rec);
+    free(rec32);
+
+    /* Normals: count mismatch, NaN / inf / zero with their index, bad stride. */
+    double *n = malloc(3 * N_GOOD * sizeof *n);
+    for (size_t i = 0; i < 3 * N_GOOD; ++i) n[i] = g_good[i] - kCentre[i % 3];
+    check_failure(gmpu_surface_set_normals_f64(s, n, N_GOOD - 1, 0), GMPU_ERROR_INVALID_INPUT,
+                  "1999 normals given for 2000 points");
+    check_failure(gmpu_surface_set_normals_f64(s, n, N_GOOD, 8), GMPU_ERROR_INVALID_ARGUMENT, "stride 8");
+    n[3 * 17 + 1] = NAN;
+    check_failure(gmpu_surface_set_normals_f64(s, n, N_GOOD, 0), GMPU_ERROR_INVALID_INPUT, "normal 17 is NaN or infinite");
+    n[3 * 17 + 1] = 0;
+    n[3 * 3] = -INFINITY;
+    check_failure(gmpu_surface_set_normals_f64(s, n, N_GOOD, 0), GMPU_ERROR_INVALID_INPUT, "normal 3 is NaN or infinite");
+    n[3 * 3] = 1;
+    n[3 * 1999] = n[3 * 1999 + 1] = n[3 * 1999 + 2] = 0;
+    check_failure(gmpu_surface_set_normals_f64(s, n, N_GOOD, 0), GMPU_ERROR_INVALID_INPUT, "normal 1999 is zero");
+    float n32[3 * N_GOOD];
+    for (size_t i = 0; i < 3 * N_GOOD; ++i) n32[i] = (float)n[i];
+    check_failure(gmpu_surface_set_normals_f32(s, n32, N_GOOD, 0), GMPU_ERROR_INVALID_INPUT, "normal 1999 is zero");
+    free(n);
+    check_usable_and_destroy(s);
+}
+
+static void test_parameters(void **state) {
+    (void)state;
+    gmpu_surface *s = new_surface();
+    struct {
+        gmpu_param key;
+        const char *name;
+        double bad[6];
+        int nbad;
+        double good;
+    } cases[] = {
+        {GMPU_PARAM_ERROR, "GMPU_PARAM_ERROR", {0, -0.1, 1, 2, NAN, INFINITY}, 6, 0.004},
+        {GMPU_PARAM_MAX_DEPTH, "GMPU_PARAM_MAX_DEPTH", {0, 17, 2.5, -1, NAN, 1e300}, 6, 8},
+        {GMPU_PARAM_MIN_POINTS, "GMPU_PARAM_MIN_POINTS", {5, 1001, 10.5, -INFINITY, NAN, 0}, 6, 20},
+        {GMPU_PARAM_SUPPORT_SCALE, "GMPU_PARAM_SUPPORT_SCALE", {0.49, 2.01, NAN, INFINITY, 0, -1}, 6, 1.0},
+        {GMPU_PARAM_SHARP_FEATURES, "GMPU_PARAM_SHARP_FEATURES", {2, -1, 0.5, NAN, 0, 0}, 4, 0},
+        {GMPU_PARAM_RESOLUTION, "GMPU_PARAM_RESOLUTION", {4, 4097, 7, 64.5, -8, NAN}, 6, 40},
+        {GMPU_PARAM_LEVEL, "GMPU_PARAM_LEVEL", {-1, 17, 1.5, NAN, 0, 0}, 4, 3},
+        {GMPU_PARAM_THREADS, "GMPU_PARAM_THREADS", {-1, 1025, 1.5, NAN, 0, 0}, 4, 2},
+        {GMPU_PARAM_MAX_CELLS, "GMPU_PARAM_MAX_CELLS", {0, 2e9, 10.5, NAN, -5, INFINITY}, 6, 1e6},
+        {GMPU_PARAM_MAX_TRIANGLES, "GMPU_PARAM_MAX_TRIANGLES", {0, 3e9, 0.5, NAN, -5, INFINITY}, 6, 1e6},
+        {GMPU_PARAM_NOISE_SCALE, "GMPU_PARAM_NOISE_SCALE", {-0.1, 20.5, NAN, INFINITY, 0, 0}, 4, 2},
+    };
+    for (size_t c = 0; c < sizeof cases / sizeof *cases; ++c) {
+        double before = -1, after = -1;
+        assert_ok(gmpu_surface_get_param(s, cases[c].key, &before));
+        for (int b = 0; b < cases[c].nbad; ++b) {
+            /* RESOLUTION 4 and 7 have their own message: "0 (automatic) or 8..4096". */
+            check_failure(gmpu_surface_set_param(s, cases[c].key, cases[c].bad[b]), GMPU_ERROR_INVALID_ARGUMENT,
+                          cases[c].name);
+            assert_non_null(strstr(gmpu_surface_last_error(s), cases[c].name));
+            assert_ok(gmpu_surface_get_param(s, cases[c].key, &after));
+            if (after != before) fail_msg("%s changed to %g by a rejected value", cases[c].name, after);
+        }
+        assert_ok(gmpu_surface_set_param(s, cases[c].key, cases[c].good));
+        assert_ok(gmpu_surface_get_param(s, cases[c].key, &after));
+        assert_true(after == cases[c].good);
+        assert_ok(gmpu_surface_set_param(s, cases[c].key, before));
+    }
+    /* The range is in the message. */
+    check_failure(gmpu_surface_set_param(s, GMPU_PARAM_MAX_DEPTH, 17), GMPU_ERROR_INVALID_ARGUMENT, "16");
+    /* Unknown keys, both directions. */
+    double v = 5;
+    check_failure(gmpu_surface_set_param(s, (gmpu_param)0, 1), GMPU_ERROR_INVALID_ARGUMENT, "unknown parameter key 0");
+    check_failure(gmpu_surface_set_param(s, (gmpu_param)999, 1), GMPU_ERROR_INVALID_ARGUMENT, "unknown parameter key 999");
+    check_failure(gmpu_surface_get_param(s, (gmpu_param)-3, &v), GMPU_ERROR_INVALID_ARGUMENT, "unknown parameter key -3");
+    check_failure(gmpu_surface_get_stat(s, (gmpu_stat)0, &v), GMPU_ERROR_INVALID_ARGUMENT, "unknown statistic key 0");
+    check_failure(gmpu_surface_get_stat(s, (gmpu_stat)77, &v), GMPU_ERROR_INVALID_ARGUMENT, "unknown statistic key 77");
+    assert_true(v == 5);
+    assert_string_equal(gmpu_status_name((gmpu_status)12345), "GMPU_UNKNOWN_STATUS");
+    assert_string_equal(gmpu_status_name(GMPU_ERROR_CANCELLED), "GMPU_ERROR_CANCELLED");
+    assert_int_equal(gmpu_version_number(), GMPU_VERSION_NUMBER);
+    assert_int_equal(gmpu_abi_version(), GMPU_ABI_VERSION);
+    check_usable_and_destroy(s);
+}
+
+static void test_evaluate_and_normals_errors(void **state) {
+    (void)state;
+    gmpu_surface *s = oriented_surface();
+    double q[12] = {0, 0, 0, 1, 1, 1, 0, NAN, 0, INFINITY, 0, 0};
+    double vals[4] = {7, 7, 7, 7}, grads[12];
+    for (int i = 0; i < 12; ++i) grads[i] = 7;
+    check_failure(gmpu_surface_evaluate(s, q, 4, vals, grads), GMPU_ERROR_INVALID_INPUT,
+                  "query point 2 is NaN or infinite");
+    for (int i = 0; i < 4; ++i) assert_true(vals[i] == 7); /* outputs untouched */
+    for (int i = 0; i < 12; ++i) assert_true(grads[i] == 7);
+    check_failure(gmpu_surface_evaluate(s, q + 9, 1, NULL, grads), GMPU_ERROR_INVALID_INPUT, "query point 0");
+    /* Far, huge and tiny queries are finite and have the right sign. */
+    const double far[] = {1e300, -1e300, 1e300, 1e10, 0, 0, kCentre[0] + 1e-300, kCentre[1], kCentre[2]};
+    assert_ok(gmpu_surface_evaluate(s, far, 3, vals, grads));
+    for (int i = 0; i < 3; ++i) assert_true(isfinite(vals[i]) || i == 0);
+    assert_true(vals[1] < 0 && vals[2] > 0);
+    for (int i = 3; i < 9; ++i) assert_true(isfinite(grads[i]));
+
+    double *n = malloc(3 * N_GOOD * sizeof *n);
+    check_failure(gmpu_surface_copy_normals(s, n, N_GOOD - 1), GMPU_ERROR_INVALID_ARGUMENT,
+                  "count 1999 differs from the 2000 points");
+    check_failure(gmpu_surface_copy_normals(s, n, 0), GMPU_ERROR_INVALID_ARGUMENT, "count 0");
+    assert_ok(gmpu_surface_copy_normals(s, n, N_GOOD));
+    /* Outward on a sphere. */
+    size_t outward = 0;
+    for (size_t i = 0; i < N_GOOD; ++i) {
+        double d = 0;
+        for (int k = 0; k < 3; ++k) d += n[3 * i + k] * (g_good[3 * i + k] - kCentre[k]);
+        outward += d > 0.9;
+    }
+    assert_true(outward > N_GOOD * 99 / 100);
+    free(n);
+
+    /* A mesh write that fails leaves no file and the mesh usable. */
+    gmpu_mesh *m = NULL;
+    assert_ok(gmpu_surface_polygonize(s, &m));
+    check_failure(gmpu_mesh_write(m, "/nonexistent-dir-gmpu/x.ply"), GMPU_ERROR_IO, "/nonexistent-dir-gmpu/x.ply");
+    check_failure(gmpu_mesh_write(m, "mesh.stl"), GMPU_ERROR_UNSUPPORTED, "'.stl'");
+    assert_null(fopen("mesh.stl", "rb"));
+    assert_null(robust_mesh_problem(m));
+    gmpu_mesh_destroy(m);
+    check_usable_and_destroy(s);
+}
+
+/* The last failure's message is per thread and per handle: a later success does not clear
+ * it, another handle's failure does not overwrite this handle's. */
+static void test_error_messages(void **state) {
+    (void)state;
+    gmpu_surface *a = new_surface(), *b = new_surface();
+    assert_string_equal(gmpu_surface_last_error(a), "");
+    check_failure(gmpu_surface_fit(a), GMPU_ERROR_WRONG_ORDER, "gmpu_surface_fit");
+    check_failure(gmpu_surface_set_param(b, GMPU_PARAM_LEVEL, 99), GMPU_ERROR_INVALID_ARGUMENT, "GMPU_PARAM_LEVEL");
+    assert_non_null(strstr(gmpu_surface_last_error(a), "gmpu_surface_fit"));
+    assert_non_null(strstr(gmpu_surface_last_error(b), "GMPU_PARAM_LEVEL"));
+    assert_non_null(strstr(gmpu_last_error(), "GMPU_PARAM_LEVEL"));
+    /* Every message starts with the status name. */
+    assert_int_equal(strncmp(gmpu_surface_last_error(a), "GMPU_ERROR_WRONG_ORDER: ", 24), 0);
+    gmpu_surface_destroy(b);
+    check_usable_and_destroy(a);
+}
+
+/* Radius of the reconstructed sphere relative to the true one, over all mesh vertices. */
+static void radius_range(const gmpu_mesh *m, const double c[3], double r, double *lo, double *hi) {
+    const double *v = gmpu_mesh_vertices(m);
+    *lo = INFINITY, *hi = 0;
+    for (size_t i = 0; i < gmpu_mesh_vertex_count(m); ++i) {
+        double d = 0;
+        for (int k = 0; k < 3; ++k) d += ((v[3 * i + k] - c[k]) / r) * ((v[3 * i + k] - c[k]) / r);
+        d = sqrt(d);
+        *lo = fmin(*lo, d), *hi = fmax(*hi, d);
+    }
+}
+
+/* Coordinates at 1e30 and 1e-30 (and 1e±300, f32 at 1e±30), centred far from the origin or
+ * not: the library normalises, so the mesh is the same sphere scaled, f scales with the
+ * units, and the statistics are in caller units. */
+static void test_extreme_scales(void **state) {
+    (void)state;
+    const double scales[] = {1.0, 1e30, 1e-30, 1e300, 1e-300, 1e-310 /* subnormal */};
+    const double offsets[] = {0.0, 1000.0};
+    double ref_lo = 0, ref_hi = 0;
+    for (size_t si = 0; si < sizeof scales / sizeof *scales; ++si)
+        for (size_t oi = 0; oi < 2; ++oi) {
+            const double scale = scales[si];
+            if (scale < 1e-300 && oi) continue; /* 1000 radii off, a subnormal sphere rounds to a point */
+            double c[3];
+            for (int k = 0; k < 3; ++k) c[k] = scale * (kCentre[k] + offsets[oi]);
+            double *p = robust_sphere(N_GOOD, c, scale, 1);
+            gmpu_surface *s = new_surface();
+            gmpu_status st = gmpu_surface_set_points_f64(s, p, N_GOOD, 0);
+            if (scale < 1e-300) {
+                /* Subnormal coordinates carry too few digits to fit anything: a clean error is
+                 * the right answer, a mesh would be too. Never garbage. */
+                if (st != GMPU_OK) {
+                    assert_true(st == GMPU_ERROR_DEGENERATE_INPUT || st == GMPU_ERROR_INVALID_INPUT);
+                    free(p);
+                    check_usable_and_destroy(s);
+                    continue;
+                }
+            }
+            if (st != GMPU_OK)
+                fail_msg("scale %g offset %g: %s", scale, offsets[oi], gmpu_last_error());
+            double diag = 0;
+            assert_ok(gmpu_surface_get_stat(s, GMPU_STAT_BBOX_DIAGONAL, &diag));
+            if (!(fabs(diag / (scale * 2 * sqrt(3.0)) - 1) < 0.02))
+                fail_msg("scale %g: bbox diagonal %g, expected %g", scale, diag, scale * 2 * sqrt(3.0));
+            assert_ok(gmpu_surface_fit(s));
+            assert_ok(gmpu_surface_orient(s));
+            gmpu_mesh *m = NULL;
+            assert_ok(gmpu_surface_polygonize(s, &m));
+            const char *problem = robust_mesh_problem(m);
+            if (problem) fail_msg("scale %g: %s", scale, problem);
+            double lo, hi;
+            radius_range(m, c, scale, &lo, &hi);
+            if (si == 0 && oi == 0) ref_lo = lo, ref_hi = hi;
+            if (!(lo > 0.95 && hi < 1.05))
+                fail_msg("scale %g offset %g: mesh radius in [%g, %g] of the true radius", scale, offsets[oi], lo, hi);
+            /* The same sphere as at scale 1 (to float precision of the normalised frame). */
+            if (oi == 0 && !(fabs(lo - ref_lo) < 1e-3 && fabs(hi - ref_hi) < 1e-3))
+                fail_msg("scale %g: radius range [%g, %g] differs from scale 1's [%g, %g]", scale, lo, hi, ref_lo,
+                         ref_hi);
+            /* f in caller units: about +r at the centre, about -r at twice the radius. */
+            double q[6] = {c[0], c[1], c[2], c[0] + 2 * scale, c[1], c[2]}, f[2], g[6];
+            assert_ok(gmpu_surface_evaluate(s, q, 2, f, g));
+            if (!(f[0] > 0.3 * scale && f[0] < 3 * scale && f[1] < -0.3 * scale && f[1] > -3 * scale))
+                fail_msg("scale %g: f(centre) = %g, f(outside) = %g", scale, f[0], f[1]);
+            for (int i = 0; i < 6; ++i) assert_true(isfinite(g[i]));
+            /* Normals are unit and finite whatever the scale. */
+            const double *mn = gmpu_mesh_normals(m);
+            for (size_t i = 0; i < gmpu_mesh_vertex_count(m); ++i) {
+                double len = sqrt(mn[3 * i] * mn[3 * i] + mn[3 * i + 1] * mn[3 * i + 1] + mn[3 * i + 2] * mn[3 * i + 2]);
+                if (!(fabs(len - 1) < 1e-6)) fail_msg("scale %g: vertex normal %zu has length %g", scale, i, len);
+            }
+            gmpu_mesh_destroy(m);
+            gmpu_surface_destroy(s);
+
+            /* float input at 1e±30 (1e±300 is not representable). */
+            if (scale >= 1e-30 && scale <= 1e30) {
+                float *p32 = malloc(3 * N_GOOD * sizeof *p32);
+                for (size_t i = 0; i < 3 * N_GOOD; ++i) p32[i] = (float)p[i];
+                s = new_surface();
+                assert_ok(gmpu_surface_set_points_f32(s, p32, N_GOOD, 0));
+                assert_ok(gmpu_surface_fit(s));
+                assert_ok(gmpu_surface_orient(s));
+                assert_ok(gmpu_surface_polygonize(s, &m));
+                assert_null(robust_mesh_problem(m));
+                radius_range(m, c, scale, &lo, &hi);
+                if (!(lo > 0.95 && hi < 1.05)) fail_msg("f32 scale %g: radius in [%g, %g]", scale, lo, hi);
+                gmpu_mesh_destroy(m);
+                gmpu_surface_destroy(s);
+                free(p32);
+            }
+            free(p);
+        }
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_null_handles_and_buffers),
+        cmocka_unit_test(test_wrong_order),
+        cmocka_unit_test(test_too_few_points),
+        cmocka_unit_test(test_tiny_clouds),
+        cmocka_unit_test(test_degenerate_clouds),
+        cmocka_unit_test(test_nonfinite_points),
+        cmocka_unit_test(test_strides_and_counts),
+        cmocka_unit_test(test_parameters),
+        cmocka_unit_test(test_evaluate_and_normals_errors),
+        cmocka_unit_test(test_error_messages),
+        cmocka_unit_test(test_extreme_scales),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}

@@ -1,0 +1,360 @@
+// Unit tests of the C++ modules, one group per concept, each against an answer known in
+// advance: quadric algebra, the three fits, the robust Taubin error, the noise estimate,
+// belief propagation, the marching-tetrahedra table (closed surfaces for any sign field),
+// the winding number, point-set validation, mesh clean-up and the parallel loop.
+#include <atomic>
+#include <cmath>
+#include <map>
+#include <random>
+#include <cstring>
+#include <stdexcept>
+#include <vector>
+
+#include "core/error.hpp"
+#include "core/parallel.hpp"
+#include "core/progress.hpp"
+#include "fit/fits.hpp"
+#include "fit/noise_estimate.hpp"
+#include "geometry/point_set.hpp"
+#include "mesh/marching_tetrahedra.hpp"
+#include "mesh/mesh_cleanup.hpp"
+#include "orient/belief_propagation.hpp"
+
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+extern "C" {
+#include <cmocka.h>
+}
+
+using Eigen::Vector3d;
+using namespace gmpu;
+
+namespace {
+
+#define assert_near(a, b, tol) assert_true(std::abs((a) - (b)) <= (tol))
+
+std::vector<double> flat(const PointList &pts) {
+    std::vector<double> out;
+    for (const auto &p : pts) out.insert(out.end(), {p[0], p[1], p[2]});
+    return out;
+}
+
+PointList sphere_points(size_t n, double r, double noise, uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<double> g(0, 1);
+    PointList pts;
+    for (size_t i = 0; i < n; ++i) {
+        Vector3d d(g(rng), g(rng), g(rng));
+        pts.push_back(r * d.normalized() + noise * Vector3d(g(rng), g(rng), g(rng)));
+    }
+    return pts;
+}
+
+// ---- quadrics and fits ---------------------------------------------------------------
+
+void quadric_algebra(void **) {
+    // (x + 2y − 1)(3z + 1) expanded and evaluated against the product of the factors.
+    Quadric a = Quadric::affine({1, 2, 0}, -1), b = Quadric::affine({0, 0, 3}, 1);
+    Quadric p = Quadric::product(a, b) + 2.0 * a - b;
+    for (Vector3d y : {Vector3d(0.3, -1, 2), Vector3d(-2, 0.5, 0.1), Vector3d(0, 0, 0)}) {
+        double expect = (y[0] + 2 * y[1] - 1) * (3 * y[2] + 1) + 2 * (y[0] + 2 * y[1] - 1) - (3 * y[2] + 1);
+        assert_near(p.value(y), expect, 1e-12);
+        // The analytic gradient against central differences.
+        for (int d = 0; d < 3; ++d) {
+            Vector3d e = Vector3d::Zero();
+            e[d] = 1e-6;
+            assert_near(p.gradient(y)[d], (p.value(y + e) - p.value(y - e)) / 2e-6, 1e-6);
+        }
+    }
+}
+
+void bivariate_fit_is_exact_on_a_paraboloid(void **) {
+    // z = 0.4x² + 0.2y² + 0.02 on a symmetric grid, so the PCA frame is the xyz frame: the
+    // fit must reproduce it (Taubin error ~ 0), with ∇Q about unit length.
+    PointList pts;
+    for (int i = -10; i <= 10; ++i)
+        for (int j = -10; j <= 10; ++j) {
+            double x = 0.1 * i, y = 0.1 * j;
+            pts.emplace_back(x, y, 0.4 * x * x + 0.2 * y * y + 0.02);
+        }
+    Pca pca = compute_pca(pts);
+    assert_true(pca.variation < 0.25);
+    LocalShape s;
+    s.q = fit_bivariate(pts, pca, 1.0);
+    assert_true(taubin_error(s, {}, pts) < 1e-4);
+    for (const auto &p : pts) assert_true(s.q.gradient(p).norm() > 0.9 && s.q.gradient(p).norm() < 2.0);
+}
+
+void general_quadric_fits_a_sphere(void **) {
+    PointList pts = sphere_points(500, 0.7, 0, 5);
+    Pca pca = compute_pca(pts);
+    assert_true(pca.variation > 0.25);  // about isotropic: the general-quadric branch
+    LocalShape s;
+    s.model = Model::quadric;
+    s.q = fit_general_quadric(pts, 1.0);
+    assert_true(taubin_error(s, {}, pts) < 1e-6);
+    // One consistent sign on each side, unit mean gradient on the data.
+    assert_true(s.q.value({0, 0, 0}) * s.q.value({2, 0, 0}) < 0);
+    double mean = 0;
+    for (const auto &p : pts) mean += s.q.gradient(p).norm();
+    assert_near(mean / double(pts.size()), 1.0, 1e-9);
+}
+
+void pca_surface_variation(void **) {
+    PointList plane;
+    for (int i = 0; i < 20; ++i)
+        for (int j = 0; j < 20; ++j) plane.emplace_back(i * 0.1, j * 0.1, 0.5);
+    Pca p = compute_pca(plane);
+    assert_near(p.variation, 0.0, 1e-12);
+    assert_near(std::abs(p.normal().dot(Vector3d::UnitZ())), 1.0, 1e-9);
+}
+
+void robust_taubin_error(void **) {
+    // A plane fit with 1 of 100 points off by 0.3: the error is max/3 (0.1), not 0.3; with 20
+    // of 100 points off by 0.03, the 90th percentile (0.03) decides.
+    PointList pts;
+    for (int i = 0; i < 100; ++i) pts.emplace_back(0.01 * i, 0.02 * (i % 7), 0.0);
+    LocalShape plane;
+    plane.q = Quadric::affine({0, 0, 1}, 0);
+    pts[10][2] = 0.3;
+    assert_near(taubin_error(plane, {}, pts), 0.1, 1e-12);
+    pts[10][2] = 0;
+    for (int i = 0; i < 20; ++i) pts[size_t(i)][2] = 0.03;
+    assert_near(taubin_error(plane, {}, pts), 0.03, 1e-12);
+}
+
+void noise_estimate_tracks_the_noise(void **) {
+    for (double sigma : {0.0, 0.005, 0.02}) {
+        std::vector<double> xyz = flat(sphere_points(30000, 1.0, sigma, 17));
+        PointSet ps = PointSet::from_array(xyz.data(), 30000, 0, 15);
+        // In normalised units: the sphere's longest side (2) becomes 1.
+        double est = estimate_noise(ps) * 2.0;
+        fprintf(stderr, "  sigma %.3f estimated %.4f\n", sigma, est);
+        if (sigma == 0) assert_true(est < 0.001);
+        else assert_true(est > 0.6 * sigma && est < 1.3 * sigma);
+    }
+}
+
+// ---- point set ---------------------------------------------------------------------
+
+template <class Fn>
+gmpu_status status_of(Fn &&fn, std::string *message = nullptr) {
+    try {
+        fn();
+    } catch (const Error &e) {
+        if (message) *message = e.what();
+        return e.status();
+    }
+    return GMPU_OK;
+}
+
+void point_set_validation(void **) {
+    std::vector<double> xyz = flat(sphere_points(100, 1, 0, 1));
+    std::string msg;
+    xyz[3 * 42 + 1] = NAN;
+    assert_int_equal(status_of([&] { PointSet::from_array(xyz.data(), 100, 0, 15); }, &msg), GMPU_ERROR_INVALID_INPUT);
+    assert_non_null(strstr(msg.c_str(), "point 42"));
+    xyz = flat(sphere_points(100, 1, 0, 1));
+    assert_int_equal(status_of([&] { PointSet::from_array(xyz.data(), 10, 0, 15); }), GMPU_ERROR_INVALID_INPUT);
+
+    std::vector<double> line, plane, same(300, 2.5);
+    for (int i = 0; i < 100; ++i) {
+        line.insert(line.end(), {double(i), 2.0 * i, -1.0 * i});
+        plane.insert(plane.end(), {double(i % 10), double(i / 10), 3.0});
+    }
+    assert_int_equal(status_of([&] { PointSet::from_array(line.data(), 100, 0, 15); }, &msg), GMPU_ERROR_DEGENERATE_INPUT);
+    assert_non_null(strstr(msg.c_str(), "collinear"));
+    assert_int_equal(status_of([&] { PointSet::from_array(plane.data(), 100, 0, 15); }, &msg), GMPU_ERROR_DEGENERATE_INPUT);
+    assert_non_null(strstr(msg.c_str(), "coplanar"));
+    assert_int_equal(status_of([&] { PointSet::from_array(same.data(), 100, 0, 15); }, &msg), GMPU_ERROR_DEGENERATE_INPUT);
+    assert_non_null(strstr(msg.c_str(), "identical"));
+}
+
+void point_set_normalises_and_searches(void **) {
+    // A strided float array; the box's longest side becomes 1 and its centre the origin.
+    std::vector<float> data;
+    PointList pts = sphere_points(2000, 3.0, 0, 2);
+    for (const auto &p : pts) data.insert(data.end(), {float(p[0] + 10), float(p[1]), float(p[2]), 99.0f});
+    PointSet ps = PointSet::from_array(data.data(), 2000, 4 * sizeof(float), 15);
+    assert_near((ps.box_max() - ps.box_min()).maxCoeff(), 1.0, 1e-9);
+    assert_near(ps.normalisation().to_world(ps.point(7))[0], data[4 * 7], 1e-5);
+    // Bounded nearest: nothing beyond the radius, and the same answer as unbounded within it.
+    std::vector<uint32_t> a, b;
+    std::vector<float> da, db;
+    ps.nearest(Vector3d(3, 0, 0), 4, a, da, 0.1);
+    assert_int_equal(a.size(), 0);
+    ps.nearest(ps.point(5), 4, a, da, 0.2);
+    ps.nearest(ps.point(5), 4, b, db);
+    assert_true(a == b);
+}
+
+// ---- belief propagation ---------------------------------------------------------------
+
+void bp_follows_clamped_evidence(void **) {
+    // A chain 0 – 1 – 2 – 3 with node 0 clamped to −1; edges agree (+4), disagree (−4),
+    // agree (+2): labels −1, −1, +1, +1.
+    BpGraph g;
+    g.clamp = {-1, 0, 0, 0};
+    g.edges = {{0, 1, 4}, {1, 2, -4}, {2, 3, 2}};
+    BpResult r = solve_bp(g, 0.01, 20);
+    assert_true(r.label == std::vector<int8_t>({-1, -1, 1, 1}));
+    // A loop with one inconsistent edge: the weaker edge gives way.
+    g.clamp = {1, 0, 0};
+    g.edges = {{0, 1, 4}, {1, 2, 4}, {2, 0, -2}};
+    r = solve_bp(g, 0.01, 30);
+    assert_true(r.label[1] == 1 && r.label[2] == 1);
+}
+
+void bp_data_term_breaks_ties_only(void **) {
+    // No evidence at all: the data term keeps the fitted sign (+1); a single agreement of
+    // 2 outweighs it.
+    BpGraph g;
+    g.clamp = {0};
+    assert_int_equal(solve_bp(g, 0.01, 5).label[0], 1);
+    g.clamp = {-1, 0};
+    g.edges = {{0, 1, 2}};
+    assert_int_equal(solve_bp(g, 0.01, 5).label[1], -1);
+}
+
+// ---- marching tetrahedra --------------------------------------------------------------
+
+void tetrahedra_cases_separate_signs(void **) {
+    // Every triangle of every case cuts edges joining an inside and an outside corner, and
+    // is wound with its normal towards the outside corners.
+    for (int t = 0; t < mt::kTetrahedra; ++t)
+        for (int mask = 0; mask < 16; ++mask) {
+            const mt::TetCase &c = mt::tet_case(t, mask);
+            int inside = __builtin_popcount(unsigned(mask));
+            assert_int_equal(c.triangle_count, inside == 0 || inside == 4 ? 0 : (inside == 2 ? 2 : 1));
+            for (int k = 0; k < c.triangle_count; ++k)
+                for (const mt::Edge &e : c.triangles[k]) {
+                    int a = -1, b = -1;
+                    for (int q = 0; q < 4; ++q) {
+                        if (mt::kTetCorners[t][q] == e.from) a = q;
+                        if (mt::kTetCorners[t][q] == e.to) b = q;
+                    }
+                    assert_true(a >= 0 && b >= 0);
+                    assert_true(((mask >> a) & 1) != ((mask >> b) & 1));
+                }
+        }
+}
+
+void marching_tetrahedra_closes_any_sign_field(void **) {
+    // Random values on a 7³ grid whose border is all negative: the union of every cube's
+    // tetrahedra cases, welded by grid edge, is a closed, consistently wound surface.
+    const int n = 7;
+    std::mt19937_64 rng(11);
+    std::uniform_real_distribution<double> u(-1, 1);
+    std::vector<double> v(n * n * n);
+    auto id = [&](int i, int j, int k) { return i + n * (j + n * k); };
+    for (int k = 0; k < n; ++k)
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i) {
+                bool border = i == 0 || j == 0 || k == 0 || i == n - 1 || j == n - 1 || k == n - 1;
+                v[size_t(id(i, j, k))] = border ? -1 : u(rng);
+            }
+    std::map<uint64_t, uint32_t> vertex;
+    std::vector<uint32_t> tris;
+    for (int k = 0; k + 1 < n; ++k)
+        for (int j = 0; j + 1 < n; ++j)
+            for (int i = 0; i + 1 < n; ++i)
+                for (int t = 0; t < mt::kTetrahedra; ++t) {
+                    int mask = 0;
+                    for (int q = 0; q < 4; ++q) {
+                        int c = mt::kTetCorners[t][q];
+                        if (v[size_t(id(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1)))] > 0) mask |= 1 << q;
+                    }
+                    const mt::TetCase &tc = mt::tet_case(t, mask);
+                    for (int tri = 0; tri < tc.triangle_count; ++tri)
+                        for (const mt::Edge &e : tc.triangles[tri]) {
+                            int c = e.from;
+                            uint64_t key = uint64_t(id(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1))) * 8 +
+                                           uint64_t(mt::edge_direction(e));
+                            auto it = vertex.emplace(key, uint32_t(vertex.size())).first;
+                            tris.push_back(it->second);
+                        }
+                }
+    assert_true(tris.size() > 30);
+    std::map<std::pair<uint32_t, uint32_t>, int> directed;
+    for (size_t t = 0; t < tris.size(); t += 3)
+        for (int e = 0; e < 3; ++e) ++directed[{tris[t + size_t(e)], tris[t + size_t((e + 1) % 3)]}];
+    for (const auto &[edge, count] : directed) {
+        assert_int_equal(count, 1);  // no directed edge twice: consistent winding
+        auto twin = directed.find({edge.second, edge.first});
+        assert_true(twin != directed.end());  // every edge has its opposite: closed
+    }
+}
+
+// ---- mesh clean-up ----------------------------------------------------------------------
+
+void unsupported_components_are_dropped(void **) {
+    // Two tetrahedra; only the second is voted for.
+    Mesh m;
+    for (int s = 0; s < 2; ++s) {
+        double o = 5.0 * s;
+        m.vertices.insert(m.vertices.end(), {o, 0, 0, o + 1, 0, 0, o, 1, 0, o, 0, 1});
+        uint32_t b = uint32_t(4 * s);
+        m.triangles.insert(m.triangles.end(), {b, b + 2, b + 1, b, b + 1, b + 3, b, b + 3, b + 2, b + 1, b + 2, b + 3});
+    }
+    std::vector<uint32_t> comp;
+    assert_int_equal(vertex_components(m, comp), 2);
+    remove_unsupported_components(m, {0, 0, 0, 0, 1, 2, 0, 0}, 3);
+    assert_int_equal(m.vertex_count(), 4);
+    assert_int_equal(m.triangle_count(), 4);
+    assert_near(m.vertices[0], 5.0, 0);
+    for (uint32_t t : m.triangles) assert_true(t < 4);
+}
+
+// ---- parallel loop ------------------------------------------------------------------------
+
+void parallel_for_runs_each_index_once(void **) {
+    Progress progress(nullptr, nullptr, GMPU_STAGE_FIT);
+    std::vector<std::atomic<int>> hits(10007);
+    parallel_for(0, hits.size(), 4, progress, [&](size_t i) { hits[i]++; });
+    for (auto &h : hits) assert_int_equal(h.load(), 1);
+}
+
+void parallel_for_rethrows_and_cancels(void **) {
+    Progress progress(nullptr, nullptr, GMPU_STAGE_FIT);
+    std::atomic<size_t> ran{0};
+    gmpu_status s = status_of([&] {
+        parallel_for(0, 100000, 2, progress, [&](size_t i) {
+            ++ran;
+            if (i == 50) throw Error(GMPU_ERROR_INTERNAL, "boom");
+        }, 0, 0, 1);
+    });
+    assert_int_equal(s, GMPU_ERROR_INTERNAL);
+    assert_true(ran.load() < 100000);  // the others stopped early
+    // A callback returning non-zero cancels: the loop stops and the stage throws CANCELLED.
+    int calls = 0;
+    Progress cancelling([](void *user, gmpu_stage, double) -> int { return ++*static_cast<int *>(user) >= 1; }, &calls,
+                        GMPU_STAGE_ORIENT);
+    cancelling.report(0.1, true);
+    assert_true(cancelling.cancelled());
+    assert_int_equal(status_of([&] { cancelling.throw_if_cancelled(); }), GMPU_ERROR_CANCELLED);
+}
+
+}  // namespace
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(quadric_algebra),
+        cmocka_unit_test(bivariate_fit_is_exact_on_a_paraboloid),
+        cmocka_unit_test(general_quadric_fits_a_sphere),
+        cmocka_unit_test(pca_surface_variation),
+        cmocka_unit_test(robust_taubin_error),
+        cmocka_unit_test(noise_estimate_tracks_the_noise),
+        cmocka_unit_test(point_set_validation),
+        cmocka_unit_test(point_set_normalises_and_searches),
+        cmocka_unit_test(bp_follows_clamped_evidence),
+        cmocka_unit_test(bp_data_term_breaks_ties_only),
+        cmocka_unit_test(tetrahedra_cases_separate_signs),
+        cmocka_unit_test(marching_tetrahedra_closes_any_sign_field),
+        cmocka_unit_test(unsupported_components_are_dropped),
+        cmocka_unit_test(parallel_for_runs_each_index_once),
+        cmocka_unit_test(parallel_for_rethrows_and_cancels),
+    };
+    return cmocka_run_group_tests(tests, nullptr, nullptr);
+}
