@@ -4,7 +4,7 @@
  *
  *   gmpu-reconstruct INPUT -o OUTPUT [--normals-out POINTS.ply] [--error E]
  *                    [--max-depth D] [--resolution R] [--level L] [--threads T]
- *                    [--use-normals] [--no-sharp] [--quiet]
+ *                    [--use-normals] [--sharp] [--quiet]
  *
  * Output format from the extension (.ply, .obj, .off). Exit status 0 on success, 1 on a
  * failure (one line on stderr), 2 on bad usage.
@@ -23,13 +23,13 @@
 typedef struct {
     const char *input, *output, *normals_out;
     double error, max_depth, resolution, level, threads;
-    int use_normals, no_sharp, quiet;
+    int use_normals, sharp, quiet;
 } options;
 
 static const char *usage =
     "usage: gmpu-reconstruct INPUT -o OUTPUT [--normals-out POINTS.ply] [--error E]\n"
     "                        [--max-depth D] [--resolution R] [--level L] [--threads T]\n"
-    "                        [--use-normals] [--no-sharp] [--quiet]\n"
+    "                        [--use-normals] [--sharp] [--quiet]\n"
     "  INPUT   .ply .xyz .txt .off .obj point cloud (normals ignored unless --use-normals)\n"
     "  OUTPUT  .ply .obj .off mesh (closed, outward-facing)\n";
 
@@ -77,8 +77,8 @@ static int parse_args(int argc, char **argv, options *o) {
             ++i;
         } else if (!strcmp(a, "--use-normals")) {
             o->use_normals = 1;
-        } else if (!strcmp(a, "--no-sharp")) {
-            o->no_sharp = 1;
+        } else if (!strcmp(a, "--sharp")) {
+            o->sharp = 1;
         } else if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
             o->quiet = 1;
         } else if (a[0] == '-' && a[1] != '\0') {
@@ -169,7 +169,7 @@ int main(int argc, char **argv) {
     if (!set(surface, GMPU_PARAM_ERROR, o.error) || !set(surface, GMPU_PARAM_MAX_DEPTH, o.max_depth) ||
         !set(surface, GMPU_PARAM_RESOLUTION, o.resolution) || !set(surface, GMPU_PARAM_LEVEL, o.level) ||
         !set(surface, GMPU_PARAM_THREADS, o.threads) ||
-        !set(surface, GMPU_PARAM_SHARP_FEATURES, o.no_sharp ? 0.0 : -1.0)) {
+        !set(surface, GMPU_PARAM_SHARP_FEATURES, o.sharp ? 1.0 : -1.0)) {
         rc = fail("bad parameter");
         goto done;
     }

@@ -3,7 +3,7 @@
 
     PYTHONPATH=bindings/python /usr/bin/python3 examples/python/reconstruct.py IN.ply OUT.ply \
         [--normals-out POINTS.ply] [--error E] [--max-depth D] [--resolution R] [--level L] \
-        [--threads T] [--use-normals] [--no-sharp] [--quiet]
+        [--threads T] [--use-normals] [--sharp | --no-sharp] [--quiet]
 
 IN: .ply .xyz .txt .off .obj point cloud (its normals are ignored unless --use-normals).
 OUT: .ply .obj .off mesh. Exit status 0 on success, 1 on a gmpu failure, 2 on bad usage.
@@ -54,7 +54,11 @@ def main(argv=None) -> int:
     ap.add_argument("--level", type=int, help="level-of-detail cap (0: all levels)")
     ap.add_argument("--threads", type=int, help="worker threads (0: every core)")
     ap.add_argument("--use-normals", action="store_true", help="orient by the input file's normals")
-    ap.add_argument("--no-sharp", action="store_true", help="smooth models only, no sharp features")
+    sharp = ap.add_mutually_exclusive_group()
+    sharp.add_argument("--sharp", dest="sharp", action="store_const", const=True,
+                       help="fit piecewise quadrics at sharp edges and corners")
+    sharp.add_argument("--no-sharp", dest="sharp", action="store_const", const=False,
+                       help="smooth models only (the library's default decides when neither is given)")
     ap.add_argument("-q", "--quiet", action="store_true", help="no progress or summary")
     args = ap.parse_args(argv)
 
@@ -65,7 +69,7 @@ def main(argv=None) -> int:
             print(f"reconstruct.py: --use-normals given but {args.input} has no normals", file=sys.stderr)
             return 1
         params = dict(error=args.error, max_depth=args.max_depth, resolution=args.resolution, level=args.level,
-                      threads=args.threads, sharp_features=False if args.no_sharp else None)
+                      threads=args.threads, sharp_features=args.sharp)
         with gmpu.Surface(cloud, normals=cloud.normals if args.use_normals else None,
                           progress=None if args.quiet else progress_printer(), **params) as surface:
             surface.fit()

@@ -110,8 +110,11 @@ typedef enum gmpu_param {
     /* α: support radius = α × cell diagonal. Default 0.75, range [0.5, 2]. Discards a
      * previous fit. */
     GMPU_PARAM_SUPPORT_SCALE = 4,
-    /* 1 (default): fit piecewise quadrics at sharp edges and corners; 0: smooth models
-     * only. Discards a previous fit. */
+    /* 1: fit piecewise quadrics (min of two or three bivariate quadratics) where a small
+     * cell straddles a sharp edge or corner, found by clustering local normals (paper §3.2).
+     * 0 (default): smooth models only — on every cloud we measure, the piecewise fits
+     * needed fewer cells but gave slightly larger distances (the grid polygonizer rounds
+     * edges anyway) and occasionally a false edge; see README. Discards a previous fit. */
     GMPU_PARAM_SHARP_FEATURES = 5,
     /* Polygonize: grid cubes along the longest side of the points' bounding box.
      * 0 (default) picks one from the octree (fine enough for the detail the fit has).

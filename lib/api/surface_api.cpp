@@ -2,6 +2,7 @@
 // (points → fitted → oriented), each verb checking that the stage before it is done.
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <memory>
@@ -112,15 +113,22 @@ double get_param(const gmpu::Params &p, gmpu_param key) {
     throw Error(GMPU_ERROR_INVALID_ARGUMENT, "unknown parameter key " + std::to_string(int(key)));
 }
 
+// Shortest exact-enough text for a parameter value ("16", "0.002", "1e+09").
+std::string number(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return buf;
+}
+
 void set_param(gmpu::Params &p, gmpu_param key, double value) {
     ParamSpec s = spec(key);
     bool open_low = key == GMPU_PARAM_ERROR;  // ε must be positive
     if (!std::isfinite(value) || value < s.lo || value > s.hi || (open_low && value <= s.lo) ||
         (key == GMPU_PARAM_ERROR && value >= s.hi) || (s.integer && value != std::floor(value)))
         throw Error(GMPU_ERROR_INVALID_ARGUMENT,
-                    std::string(s.name) + " = " + std::to_string(value) + " is out of range: expected " +
+                    std::string(s.name) + " = " + number(value) + " is out of range: expected " +
                         (s.integer ? "an integer " : "a number ") + (open_low ? "in (" : "in [") +
-                        std::to_string(s.lo) + ", " + std::to_string(s.hi) + (key == GMPU_PARAM_ERROR ? ")" : "]"));
+                        number(s.lo) + ", " + number(s.hi) + (key == GMPU_PARAM_ERROR ? ")" : "]"));
     if (key == GMPU_PARAM_RESOLUTION && value > 0 && value < 8)
         throw Error(GMPU_ERROR_INVALID_ARGUMENT, "GMPU_PARAM_RESOLUTION must be 0 (automatic) or 8..4096");
     double scratch = 0;
@@ -303,6 +311,7 @@ GMPU_API gmpu_status gmpu_surface_fit(gmpu_surface *s) {
         const double noise = gmpu::estimate_noise(s->points);
         const double epsilon = gmpu::effective_epsilon(s->points, s->params, noise);
         gmpu::Octree tree = gmpu::build_octree(s->points, s->params, epsilon, progress);
+        progress.throw_if_cancelled();  // a cancel on the final report counts too
         s->discard_fit();
         s->tree = std::move(tree);
         s->noise = noise;
@@ -336,6 +345,7 @@ GMPU_API gmpu_status gmpu_surface_orient(gmpu_surface *s) {
         s->measures = std::move(measures);
         s->winding = gmpu::WindingField(tree, s->points, s->measures.normals, s->measures.area);
         progress.report(1.0, true);
+        progress.throw_if_cancelled();  // a cancel on the final report counts too
         s->orient_stats = stats;
         s->stage = gmpu_surface::Stage::oriented;
         s->seconds[GMPU_STAGE_ORIENT] = since(t0);
@@ -391,6 +401,7 @@ GMPU_API gmpu_status gmpu_surface_polygonize(gmpu_surface *s, gmpu_mesh **out) {
         const gmpu::MpuFunction mpu(s->tree, s->params.level);
         auto mesh = std::make_unique<gmpu_mesh>();
         mesh->mesh = gmpu::polygonize(mpu, s->winding, s->points, s->measures, resolution, s->params, progress);
+        progress.throw_if_cancelled();  // a cancel on the final report counts too
         s->last_resolution = resolution;
         s->seconds[GMPU_STAGE_POLYGONIZE] = since(t0);
         *out = mesh.release();

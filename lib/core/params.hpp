@@ -9,7 +9,7 @@ struct Params {
     int max_depth = 10;            // deepest octree level
     int min_points = 15;           // N_min: fewest points in a support ball
     double support_scale = 0.75;   // α: R = α × cell diagonal
-    bool sharp_features = true;    // piecewise quadrics at edges and corners
+    bool sharp_features = false;   // piecewise quadrics at edges and corners (experimental)
     int resolution = 0;            // polygonize grid, 0 = from the octree
     int level = 0;                 // level-of-detail cap, 0 = all levels
     unsigned threads = 0;          // 0 = every core

@@ -8,6 +8,9 @@ namespace {
 // Large supports (coarse cells) are fitted on an even subsample: the fit of a coarse cell
 // only has to be roughly right, and its error is still measured on every point.
 constexpr size_t kMaxFitPoints = 2048;
+// Sharp features are looked for only in small supports (finest cells): in large ones two
+// clusters of normals mostly mean curvature, not an edge.
+constexpr size_t kMaxSharpSupport = 64;
 
 const PointList &fit_sample(const PointList &support, PointList &buffer) {
     if (support.size() <= kMaxFitPoints) return support;
@@ -35,7 +38,7 @@ CellFit fit_cell(const PointList &support, double radius, double epsilon, const 
     }
     fit.error = taubin_error(fit.shape, no_pieces, support);
 
-    if (fit.error > epsilon && params.sharp_features) {
+    if (fit.error > epsilon && params.sharp_features && support.size() <= kMaxSharpSupport) {
         CellFit sharp;
         if (fit_piecewise(support, radius, epsilon, sharp) && sharp.error < fit.error) {
             sharp.variation = fit.variation;

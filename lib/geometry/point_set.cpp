@@ -1,6 +1,7 @@
 #include "geometry/point_set.hpp"
 
 #include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <string>
 
@@ -85,6 +86,13 @@ struct BoundedKnnResultSet {
     }
 };
 
+// %g text of a coordinate for messages ("1e+301").
+std::string number(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return buf;
+}
+
 }  // namespace
 
 struct PointSet::Index {
@@ -124,17 +132,28 @@ PointSet PointSet::from_array(const T *xyz, size_t count, size_t stride, size_t 
         lo = lo.cwiseMin(p);
         hi = hi.cwiseMax(p);
     }
+    // Normalising must neither overflow nor underflow: extent, centre and diagonal are finite
+    // and non-zero for coordinates within ±1e300 spanning more than 1e-300 (1e±30 is the
+    // usual extreme); outside that, say so instead of meshing inf/NaN or reporting a wrong
+    // diagonal (extent.norm() squares: 0 at 1e-300, inf at 1e300).
+    double magnitude = std::max(lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff());
+    if (magnitude > 1e300)
+        throw Error(GMPU_ERROR_INVALID_INPUT, "a coordinate of magnitude " + number(magnitude) +
+                                                  " is beyond 1e300: too close to the largest double to "
+                                                  "normalise; rescale the points");
     Eigen::Vector3d extent = hi - lo;
     double longest = extent.maxCoeff();
-    double magnitude = std::max(lo.cwiseAbs().maxCoeff(), hi.cwiseAbs().maxCoeff());
-    if (!(longest > 0.0) || !std::isfinite(longest) || longest <= magnitude * 1e-12)
+    if (!(longest > 0.0) || longest <= magnitude * 1e-12)
         throw Error(GMPU_ERROR_DEGENERATE_INPUT,
                     "all points are identical (to 12 digits): they bound no volume");
+    if (longest < 1e-300)
+        throw Error(GMPU_ERROR_INVALID_INPUT, "the points span only " + number(longest) +
+                                                  ", below 1e-300: too small to normalise; rescale the points");
 
     PointSet set;
     set.norm_.centre = 0.5 * (lo + hi);
     set.norm_.scale = 1.0 / longest;
-    set.world_diagonal_ = extent.norm();
+    set.world_diagonal_ = extent.stableNorm();
     set.box_min_ = set.norm_.to_unit(lo);
     set.box_max_ = set.norm_.to_unit(hi);
     set.points_.resize(3 * count);

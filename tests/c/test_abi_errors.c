@@ -322,7 +322,7 @@ static void test_nonfinite_points(void **state) {
         }
     /* A double finite but beyond float: the f64 entry point copes (it normalises first). */
     memcpy(p, g_good, 3 * N_GOOD * sizeof *p);
-    for (size_t i = 0; i < 3 * N_GOOD; ++i) p[i] *= 1e300;
+    for (size_t i = 0; i < 3 * N_GOOD; ++i) p[i] *= 1e200;
     assert_ok(gmpu_surface_set_points_f64(s, p, N_GOOD, 0));
     free(p);
     free(p32);
@@ -507,71 +507,66 @@ static void test_error_messages(void **state) {
     check_usable_and_destroy(a);
 }
 
-/* Radius of the reconstructed sphere relative to the true one, over all mesh vertices. */
-static void radius_range(const gmpu_mesh *m, const double c[3], double r, double *lo, double *hi) {
+/* Distance of every mesh vertex to the torus (major R, minor r, centre c, axis z), as a
+ * fraction of r: the largest. */
+static double torus_deviation(const gmpu_mesh *m, const double c[3], double R, double r) {
     const double *v = gmpu_mesh_vertices(m);
-    *lo = INFINITY, *hi = 0;
+    double worst = 0;
     for (size_t i = 0; i < gmpu_mesh_vertex_count(m); ++i) {
-        double d = 0;
-        for (int k = 0; k < 3; ++k) d += ((v[3 * i + k] - c[k]) / r) * ((v[3 * i + k] - c[k]) / r);
-        d = sqrt(d);
-        *lo = fmin(*lo, d), *hi = fmax(*hi, d);
+        double x = (v[3 * i] - c[0]) / r, y = (v[3 * i + 1] - c[1]) / r, z = (v[3 * i + 2] - c[2]) / r;
+        double d = fabs(hypot(hypot(x, y) - R / r, z) - 1);
+        worst = fmax(worst, d);
     }
+    return worst;
 }
 
-/* Coordinates at 1e30 and 1e-30 (and 1e±300, f32 at 1e±30), centred far from the origin or
- * not: the library normalises, so the mesh is the same sphere scaled, f scales with the
- * units, and the statistics are in caller units. */
+/* Coordinates at 1e30 and 1e-30 (and 1e±290, f32 at 1e±30), centred far from the origin or
+ * not: the library normalises, so a torus (which needs a real octree, unlike a sphere that
+ * one quadric fits) gives the same octree and the same mesh scaled, f scales with the
+ * units, and the statistics are in caller units. Beyond ±1e300 or below a 1e-300 span, a
+ * clean INVALID_INPUT. */
 static void test_extreme_scales(void **state) {
     (void)state;
-    const double scales[] = {1.0, 1e30, 1e-30, 1e300, 1e-300, 1e-310 /* subnormal */};
+    enum { N = 4000 };
+    const double R = 1.0, r = 0.4;
+    const double scales[] = {1.0, 1e30, 1e-30, 1e290, 1e-290};
     const double offsets[] = {0.0, 1000.0};
-    double ref_lo = 0, ref_hi = 0;
+    double ref_cells = 0, ref_dev = 0;
     for (size_t si = 0; si < sizeof scales / sizeof *scales; ++si)
         for (size_t oi = 0; oi < 2; ++oi) {
             const double scale = scales[si];
-            if (scale < 1e-300 && oi) continue; /* 1000 radii off, a subnormal sphere rounds to a point */
             double c[3];
             for (int k = 0; k < 3; ++k) c[k] = scale * (kCentre[k] + offsets[oi]);
-            double *p = robust_sphere(N_GOOD, c, scale, 1);
+            double *p = robust_torus(N, scale * R, scale * r, c, 4);
             gmpu_surface *s = new_surface();
-            gmpu_status st = gmpu_surface_set_points_f64(s, p, N_GOOD, 0);
-            if (scale < 1e-300) {
-                /* Subnormal coordinates carry too few digits to fit anything: a clean error is
-                 * the right answer, a mesh would be too. Never garbage. */
-                if (st != GMPU_OK) {
-                    assert_true(st == GMPU_ERROR_DEGENERATE_INPUT || st == GMPU_ERROR_INVALID_INPUT);
-                    free(p);
-                    check_usable_and_destroy(s);
-                    continue;
-                }
-            }
-            if (st != GMPU_OK)
-                fail_msg("scale %g offset %g: %s", scale, offsets[oi], gmpu_last_error());
-            double diag = 0;
+            assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_RESOLUTION, 32));
+            gmpu_status st = gmpu_surface_set_points_f64(s, p, N, 0);
+            if (st != GMPU_OK) fail_msg("scale %g offset %g: %s", scale, offsets[oi], gmpu_last_error());
+            double diag = 0, expected = scale * 2 * sqrt((R + r) * (R + r) * 2 + r * r);
             assert_ok(gmpu_surface_get_stat(s, GMPU_STAT_BBOX_DIAGONAL, &diag));
-            if (!(fabs(diag / (scale * 2 * sqrt(3.0)) - 1) < 0.02))
-                fail_msg("scale %g: bbox diagonal %g, expected %g", scale, diag, scale * 2 * sqrt(3.0));
+            if (!(fabs(diag / expected - 1) < 0.01))
+                fail_msg("scale %g: bbox diagonal %g, expected %g", scale, diag, expected);
             assert_ok(gmpu_surface_fit(s));
+            double cells = 0;
+            assert_ok(gmpu_surface_get_stat(s, GMPU_STAT_CELLS, &cells));
             assert_ok(gmpu_surface_orient(s));
             gmpu_mesh *m = NULL;
             assert_ok(gmpu_surface_polygonize(s, &m));
             const char *problem = robust_mesh_problem(m);
             if (problem) fail_msg("scale %g: %s", scale, problem);
-            double lo, hi;
-            radius_range(m, c, scale, &lo, &hi);
-            if (si == 0 && oi == 0) ref_lo = lo, ref_hi = hi;
-            if (!(lo > 0.95 && hi < 1.05))
-                fail_msg("scale %g offset %g: mesh radius in [%g, %g] of the true radius", scale, offsets[oi], lo, hi);
-            /* The same sphere as at scale 1 (to float precision of the normalised frame). */
-            if (oi == 0 && !(fabs(lo - ref_lo) < 1e-3 && fabs(hi - ref_hi) < 1e-3))
-                fail_msg("scale %g: radius range [%g, %g] differs from scale 1's [%g, %g]", scale, lo, hi, ref_lo,
-                         ref_hi);
-            /* f in caller units: about +r at the centre, about -r at twice the radius. */
-            double q[6] = {c[0], c[1], c[2], c[0] + 2 * scale, c[1], c[2]}, f[2], g[6];
+            const double dev = torus_deviation(m, c, scale * R, scale * r);
+            if (si == 0 && oi == 0) ref_cells = cells, ref_dev = dev;
+            assert_true(cells > 50); /* a real octree: the test would not see a broken ε otherwise */
+            /* The same octree (to float rounding of the normalised points) and the same mesh. */
+            if (!(fabs(cells - ref_cells) <= 0.02 * ref_cells && dev < 0.15 && fabs(dev - ref_dev) < 0.02))
+                fail_msg("scale %g offset %g: %g cells, mesh within %g r of the torus (scale 1: %g cells, %g r)",
+                         scale, offsets[oi], cells, dev, ref_cells, ref_dev);
+            /* f in caller units: about +r inside the tube, about -r at the centre hole. */
+            double q[6] = {c[0] + scale * R, c[1], c[2], c[0], c[1], c[2]}, f[2], g[6];
             assert_ok(gmpu_surface_evaluate(s, q, 2, f, g));
-            if (!(f[0] > 0.3 * scale && f[0] < 3 * scale && f[1] < -0.3 * scale && f[1] > -3 * scale))
-                fail_msg("scale %g: f(centre) = %g, f(outside) = %g", scale, f[0], f[1]);
+            if (!(f[0] > 0.5 * scale * r && f[0] < 2 * scale * r && f[1] < -0.3 * scale * (R - r) &&
+                  f[1] > -3 * scale * (R - r)))
+                fail_msg("scale %g: f(tube centre) = %g, f(hole) = %g", scale, f[0], f[1]);
             for (int i = 0; i < 6; ++i) assert_true(isfinite(g[i]));
             /* Normals are unit and finite whatever the scale. */
             const double *mn = gmpu_mesh_normals(m);
@@ -582,24 +577,48 @@ static void test_extreme_scales(void **state) {
             gmpu_mesh_destroy(m);
             gmpu_surface_destroy(s);
 
-            /* float input at 1e±30 (1e±300 is not representable). */
+            /* float input at 1e±30 (1e±290 is not representable). */
             if (scale >= 1e-30 && scale <= 1e30) {
-                float *p32 = malloc(3 * N_GOOD * sizeof *p32);
-                for (size_t i = 0; i < 3 * N_GOOD; ++i) p32[i] = (float)p[i];
+                float *p32 = malloc(3 * N * sizeof *p32);
+                for (size_t i = 0; i < 3 * N; ++i) p32[i] = (float)p[i];
                 s = new_surface();
-                assert_ok(gmpu_surface_set_points_f32(s, p32, N_GOOD, 0));
+                assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_RESOLUTION, 32));
+                assert_ok(gmpu_surface_set_points_f32(s, p32, N, 0));
                 assert_ok(gmpu_surface_fit(s));
                 assert_ok(gmpu_surface_orient(s));
                 assert_ok(gmpu_surface_polygonize(s, &m));
                 assert_null(robust_mesh_problem(m));
-                radius_range(m, c, scale, &lo, &hi);
-                if (!(lo > 0.95 && hi < 1.05)) fail_msg("f32 scale %g: radius in [%g, %g]", scale, lo, hi);
+                /* float keeps ~7 digits: 1000 radii off centre leaves ~4 for the shape */
+                double fdev = torus_deviation(m, c, scale * R, scale * r);
+                if (!(fdev < 0.15)) fail_msg("f32 scale %g offset %g: mesh within %g r", scale, offsets[oi], fdev);
                 gmpu_mesh_destroy(m);
                 gmpu_surface_destroy(s);
                 free(p32);
             }
             free(p);
         }
+
+    /* Beyond what can be normalised: a clean INVALID_INPUT that says how to fix it. */
+    const struct {
+        double scale, offset;
+        const char *needle;
+    } bad[] = {
+        {1e301, 0, "beyond 1e300"},            /* coordinates near the largest double */
+        {1e307, 0, "beyond 1e300"},            /* extent would overflow to inf */
+        {1e295, 2e300, "beyond 1e300"},        /* a small cloud very far out */
+        {1e-305, 0, "below 1e-300"},           /* span would underflow the normalisation */
+        {1e-310, 0, "below 1e-300"},           /* subnormal: 1 / span overflows */
+    };
+    for (size_t b = 0; b < sizeof bad / sizeof *bad; ++b) {
+        double c[3] = {bad[b].offset, bad[b].offset, 0};
+        double *p = robust_sphere(N_GOOD, c, bad[b].scale, 2);
+        gmpu_surface *s = oriented_surface();
+        check_failure2(gmpu_surface_set_points_f64(s, p, N_GOOD, 0), GMPU_ERROR_INVALID_INPUT, bad[b].needle,
+                       "rescale the points");
+        check_rejected_keeps_state(s);
+        free(p);
+        check_usable_and_destroy(s);
+    }
 }
 
 int main(void) {

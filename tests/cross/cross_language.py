@@ -153,6 +153,19 @@ def closed_problem(mesh: Mesh) -> Optional[str]:
 
 def mesh_difference(ref: Mesh, other: Mesh, tol: float = TOLERANCE) -> Optional[str]:
     """None if the meshes are the same (counts, triangles, coordinates to tol), else why not."""
+    return compare(ref, other, tol)[0]
+
+
+def compare(ref: Mesh, other: Mesh, tol: float = TOLERANCE) -> Tuple[Optional[str], float]:
+    """(None or why the meshes differ, largest coordinate difference)."""
+    problem = _difference(ref, other, tol)
+    if problem is not None:
+        return problem, float("nan")
+    return None, max((abs(a[k] - b[k]) for a, b in zip(ref.vertices, other.vertices) for k in range(3)),
+                     default=0.0)
+
+
+def _difference(ref: Mesh, other: Mesh, tol: float) -> Optional[str]:
     if len(ref.vertices) != len(other.vertices):
         return f"{len(other.vertices)} vertices, C has {len(ref.vertices)}"
     if len(ref.faces) != len(other.faces):
@@ -314,17 +327,24 @@ def main(argv: Sequence[str]) -> int:
                 if os.path.exists(out):
                     os.remove(out)
                 mesh, problem, seconds = run(lang, build, src, out)
+                ok_note = "reference" if lang == "c" else ""
                 if mesh is not None and lang == "c":
                     ref = mesh
                     problem = closed_problem(mesh) or ""
                     if problem:
                         problem = f"C mesh is not closed: {problem}"
                 elif mesh is not None:
-                    problem = mesh_difference(ref, mesh) if ref is not None else "no C mesh to compare with"
-                    problem = problem or ""
+                    if ref is None:
+                        problem = "no C mesh to compare with"
+                    else:
+                        diff, worst = compare(ref, mesh)
+                        problem = diff or ""
+                        if not problem:
+                            ok_note = f"max |dx| {worst:.1g}"
                 counts = f"{len(mesh.vertices):7d} v {len(mesh.faces):7d} t" if mesh else " " * 19
                 status = "FAIL" if problem else "ok"
-                print(f"  {cloud:<11} {lang:<7} {counts} {seconds:6.1f} s  {status} {problem}".rstrip())
+                note = problem or ok_note
+                print(f"  {cloud:<11} {lang:<7} {counts} {seconds:6.1f} s  {status:<4} {note}".rstrip())
                 if problem:
                     failures.append(f"{cloud} / {lang}: {problem}")
                 sys.stdout.flush()

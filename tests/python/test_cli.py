@@ -104,9 +104,9 @@ def test_same_parameters_same_files_as_the_cli(cli, clouds, tmp_path):
     # Non-default parameters and the oriented-points output, on a smaller cloud.
     src = clouds / "kitten_scan.ply"
     _run_cli(cli, [src, "-o", tmp_path / "cli.off", "--normals-out", tmp_path / "cli_points.ply", "--error", "0.004",
-                   "--max-depth", "8", "--resolution", "40", "--level", "6", "--no-sharp", "--threads", "1"])
+                   "--max-depth", "8", "--resolution", "40", "--level", "6", "--threads", "1"])
     cloud = gmpu.read_points(src)
-    with gmpu.Surface(cloud, error=0.004, max_depth=8, resolution=40, level=6, sharp_features=False, threads=1) as s:
+    with gmpu.Surface(cloud, error=0.004, max_depth=8, resolution=40, level=6, threads=1) as s:
         s.fit().orient()
         s.polygonize().write(tmp_path / "py.off")
         gmpu.Points(cloud.positions, s.normals).write(tmp_path / "py_points.ply")

@@ -61,20 +61,32 @@ def test_bad_gmpu_library_fails_loudly_without_falling_back(tmp_path):
 
 
 def test_error_lists_every_place_it_looked(tmp_path):
-    # A copy of the package far from any build directory or installed library.
-    shutil.copytree(BINDINGS / "gmpu", tmp_path / "gmpu", ignore=shutil.ignore_patterns("__pycache__"))
+    # A copy of the package far from any build directory or installed library, laid out
+    # like a checkout (bindings/python/gmpu) whose build directory is missing.
+    root = tmp_path / "checkout"
+    shutil.copytree(BINDINGS / "gmpu", root / "bindings" / "python" / "gmpu", ignore=shutil.ignore_patterns("__pycache__"))
+    (root / "include" / "gmpu").mkdir(parents=True)
+    (root / "include" / "gmpu" / "gmpu.h").touch()
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "GMPU_LIBRARY")}
+    env["PYTHONPATH"] = str(root / "bindings" / "python")
     r = subprocess.run([PYTHON, "-c", "import gmpu; print(gmpu.library_path)"], cwd=tmp_path, capture_output=True,
-                       text=True, env={k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "GMPU_LIBRARY")})
+                       text=True, env=env)
     if r.returncode == 0:  # libgmpu is installed system-wide on this machine: the last resort found it
         assert r.stdout.strip() == "libgmpu.so.1"
         return
     err = r.stderr
     assert "$GMPU_LIBRARY: not set" in err
-    assert f"inside the package directory: {tmp_path / 'gmpu' / 'libgmpu.so.1'}: no such file" in err
-    assert "meson build directory:" in err and "system library search path: libgmpu.so.1:" in err
+    pkg = root / "bindings" / "python" / "gmpu"
+    assert f"inside the package directory: {pkg / 'libgmpu.so.1'}: no such file" in err
+    assert f"meson build directory: {root / 'build' / 'lib' / 'libgmpu.so.1'}: no such file" in err
+    assert "system library search path: libgmpu.so.1:" in err
     assert err.index("$GMPU_LIBRARY") < err.index("inside the package") < err.index("meson build") \
         < err.index("system library")
     assert "make build" in err
+    # Outside a checkout, the build directory is not guessed at.
+    shutil.rmtree(root / "include")
+    r = subprocess.run([PYTHON, "-c", "import gmpu"], cwd=tmp_path, capture_output=True, text=True, env=env)
+    assert r.returncode != 0 and "meson build directory: not in a source checkout" in r.stderr
 
 
 def _build_options():

@@ -64,7 +64,10 @@ def find_library(environ=os.environ, package_dir: str = PACKAGE_DIR,
         return [("$GMPU_LIBRARY", path)], True
     cands = [("$GMPU_LIBRARY", None)]
     cands += _installed_candidates(package_dir)
-    cands.append(("meson build directory", os.path.join(source_root, "build", "lib", LIBRARY_NAME)))
+    if os.path.isfile(os.path.join(source_root, "include", "gmpu", "gmpu.h")):
+        cands.append(("meson build directory", os.path.join(source_root, "build", "lib", LIBRARY_NAME)))
+    else:
+        cands.append(("meson build directory", None))  # not in a source checkout
     cands.append(("system library search path", LIBRARY_NAME))
     return cands, False
 
@@ -75,7 +78,7 @@ def _load():
     seen = set()
     for what, path in candidates:
         if path is None:
-            tried.append(f"  {what}: not set")
+            tried.append(f"  {what}: " + ("not set" if what == "$GMPU_LIBRARY" else "not in a source checkout"))
             continue
         if path in seen:
             continue

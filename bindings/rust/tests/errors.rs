@@ -134,7 +134,7 @@ fn files_and_meshes() {
     let mesh = Mesh::new(&v, &[[0, 1, 2]]).unwrap();
     expect_err(mesh.write(garbage.with_extension("stl")), Status::Unsupported, "");
     expect_err(mesh.write("/nonexistent/dir/mesh.ply"), Status::Io, "");
-    let _ = std::fs::remove_dir_all(garbage.parent().unwrap());
+    remove_temp_dir("files_and_meshes");
 }
 
 #[test]

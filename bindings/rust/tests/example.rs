@@ -37,7 +37,7 @@ fn reconstructs_the_sample() {
     let oriented = gmpu::Points::read(&normals).unwrap();
     assert_eq!(oriented.len(), 35_000);
     assert!(oriented.normals().is_some());
-    let _ = std::fs::remove_dir_all(out.parent().unwrap());
+    remove_temp_dir("example");
 }
 
 #[test]
@@ -55,4 +55,5 @@ fn reports_usage_and_failures() {
     assert_eq!(run.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&run.stderr).contains("GMPU_PARAM_RESOLUTION"));
     assert!(!out.exists());
+    remove_temp_dir("example_fail");
 }

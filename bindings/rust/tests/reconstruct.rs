@@ -192,7 +192,7 @@ fn files_round_trip() {
         let n = back.normals().expect("normals written");
         assert!(n.iter().zip(&normals).all(|(a, b)| dot(*a, *b) > 0.999), "{ext}");
     }
-    let _ = std::fs::remove_dir_all(temp_path("files_round_trip", "").parent().unwrap());
+    remove_temp_dir("files_round_trip");
 }
 
 #[test]

@@ -23,11 +23,27 @@ pub fn shared_data() -> PathBuf {
     dir
 }
 
-/// A file path in a fresh temporary directory for this test.
-pub fn temp_path(test: &str, file: &str) -> PathBuf {
+/// This test's own temporary directory, `$TMPDIR/gmpu-rust-PID-TEST` (created).
+pub fn temp_dir(test: &str) -> PathBuf {
+    assert!(!test.is_empty() && !test.contains(['/', '.']), "bad test name {test:?}");
     let dir = std::env::temp_dir().join(format!("gmpu-rust-{}-{test}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    dir.join(file)
+    dir
+}
+
+/// A file path in this test's temporary directory.
+pub fn temp_path(test: &str, file: &str) -> PathBuf {
+    assert!(!file.is_empty() && !file.contains('/'), "bad file name {file:?}");
+    temp_dir(test).join(file)
+}
+
+/// Removes this test's temporary directory, and nothing else: only a directory named
+/// `gmpu-rust-PID-TEST` directly inside the system temporary directory.
+pub fn remove_temp_dir(test: &str) {
+    let dir = std::env::temp_dir().join(format!("gmpu-rust-{}-{test}", std::process::id()));
+    let name = dir.file_name().and_then(|n| n.to_str()).unwrap_or_default();
+    assert!(name.starts_with("gmpu-rust-") && dir.parent() == Some(std::env::temp_dir().as_path()));
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// `n` points on a sphere (Fibonacci lattice), centre `c`, radius `r`.

@@ -1,0 +1,187 @@
+/* Resource caps through the C ABI: GMPU_PARAM_MAX_CELLS and GMPU_PARAM_MAX_TRIANGLES fail
+ * cleanly with GMPU_ERROR_LIMIT_EXCEEDED exactly past the cap (the cap itself is allowed),
+ * quickly, without keeping a partial result, and leave the handle usable;
+ * GMPU_PARAM_MAX_DEPTH caps GMPU_STAT_DEPTH. */
+#define _GNU_SOURCE
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+
+#include "gmpu/gmpu.h"
+#include "robust_util.h"
+
+static size_t g_n;
+static double *g_bumpy; /* g_n points on a bumpy sphere: fit subdivides to depth ~6 */
+
+static int setup(void **state) {
+    (void)state;
+    g_n = robust_quick() ? 6000 : 30000;
+    g_bumpy = robust_bumpy_sphere(g_n, 5);
+    return g_bumpy ? 0 : -1;
+}
+
+static int teardown(void **state) {
+    (void)state;
+    free(g_bumpy);
+    return 0;
+}
+
+static double stat_of(const gmpu_surface *s, gmpu_stat key) {
+    double v = -1;
+    assert_ok(gmpu_surface_get_stat(s, key, &v));
+    return v;
+}
+
+static gmpu_surface *surface_with_points(void) {
+    gmpu_surface *s = NULL;
+    assert_ok(gmpu_surface_create(&s));
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_RESOLUTION, 40));
+    assert_ok(gmpu_surface_set_points_f64(s, g_bumpy, g_n, 0));
+    return s;
+}
+
+static void test_max_cells(void **state) {
+    (void)state;
+    gmpu_surface *s = surface_with_points();
+    double v = 0;
+    assert_ok(gmpu_surface_get_param(s, GMPU_PARAM_MAX_CELLS, &v));
+    assert_true(v == 2e7); /* the documented default */
+
+    assert_ok(gmpu_surface_fit(s));
+    const double cells = stat_of(s, GMPU_STAT_CELLS);
+    const double full_fit_seconds = stat_of(s, GMPU_STAT_FIT_SECONDS);
+    assert_true(cells > 200); /* the cloud needs a real octree for this test to mean anything */
+
+    /* The cap itself is allowed; one fewer is not. Changing the cap discards the fit. */
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_MAX_CELLS, cells));
+    assert_ok(gmpu_surface_fit(s));
+    assert_true(stat_of(s, GMPU_STAT_CELLS) == cells);
+    assert_ok(gmpu_surface_orient(s));
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_MAX_CELLS, cells - 1));
+    double f = 0;
+    const double centre[3] = {0, 0, 0};
+    check_failure(gmpu_surface_evaluate(s, centre, 1, &f, NULL), GMPU_ERROR_WRONG_ORDER, "orient");
+    char needle[96];
+    snprintf(needle, sizeof needle, "GMPU_PARAM_MAX_CELLS = %.0f", cells - 1);
+    check_failure(gmpu_surface_fit(s), GMPU_ERROR_LIMIT_EXCEEDED, needle);
+    assert_non_null(strstr(gmpu_surface_last_error(s), needle));
+    /* Nothing partial is kept: no cells, and orient still needs a fit. */
+    assert_true(stat_of(s, GMPU_STAT_CELLS) == 0);
+    check_failure(gmpu_surface_orient(s), GMPU_ERROR_WRONG_ORDER, "gmpu_surface_fit");
+
+    /* Tiny caps fail fast, whatever the level at which they are crossed. */
+    const double caps[] = {1, 8, 9, 60, cells / 4};
+    for (size_t k = 0; k < sizeof caps / sizeof *caps; ++k) {
+        assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_MAX_CELLS, floor(caps[k])));
+        double t0 = robust_now();
+        check_failure(gmpu_surface_fit(s), GMPU_ERROR_LIMIT_EXCEEDED, "GMPU_PARAM_MAX_CELLS");
+        double took = robust_now() - t0;
+        if (!robust_quick() && took > full_fit_seconds + 0.5)
+            fail_msg("cap %g: the failing fit took %.3f s, the whole fit %.3f s", caps[k], took, full_fit_seconds);
+    }
+
+    /* Back to a big cap: the same handle fits, orients and meshes. */
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_MAX_CELLS, 1e9));
+    gmpu_mesh *m = robust_reconstruct(s, g_bumpy, g_n);
+    assert_true(stat_of(s, GMPU_STAT_CELLS) == cells);
+    assert_null(robust_mesh_problem(m));
+    gmpu_mesh_destroy(m);
+    gmpu_surface_destroy(s);
+}
+
+static void test_max_triangles(void **state) {
+    (void)state;
+    gmpu_surface *s = surface_with_points();
+    double v = 0;
+    assert_ok(gmpu_surface_get_param(s, GMPU_PARAM_MAX_TRIANGLES, &v));
+    assert_true(v == 1e8);
+    assert_ok(gmpu_surface_fit(s));
+    assert_ok(gmpu_surface_orient(s));
+    gmpu_mesh *m = NULL;
+    assert_ok(gmpu_surface_polygonize(s, &m));
+    const size_t tris = gmpu_mesh_triangle_count(m);
+    const double full_seconds = stat_of(s, GMPU_STAT_POLYGONIZE_SECONDS);
+    assert_true(tris > 1000);
+    gmpu_mesh_destroy(m);
+
+    /* The cap counts the triangles marching tetrahedra makes, before pieces that no input
+     * point supports are dropped, so its exact boundary is not observable from here: half
+     * the final count fails, 1.5 times it succeeds. Neither discards the orientation. */
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_MAX_TRIANGLES, (double)(tris + tris / 2)));
+    m = NULL;
+    assert_ok(gmpu_surface_polygonize(s, &m));
+    assert_int_equal(gmpu_mesh_triangle_count(m), tris);
+    gmpu_mesh_destroy(m);
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_MAX_TRIANGLES, (double)(tris / 2)));
+    m = (gmpu_mesh *)&m;
+    char needle[96];
+    snprintf(needle, sizeof needle, "GMPU_PARAM_MAX_TRIANGLES = %zu", tris / 2);
+    check_failure(gmpu_surface_polygonize(s, &m), GMPU_ERROR_LIMIT_EXCEEDED, needle);
+    assert_null(m);
+    double f = 0;
+    const double centre[3] = {0, 0, 0};
+    assert_ok(gmpu_surface_evaluate(s, centre, 1, &f, NULL));
+    assert_true(f > 0.5);
+
+    /* A tiny cap on a fine grid fails fast: long before the whole grid is done. */
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_MAX_TRIANGLES, 100));
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_RESOLUTION, 400));
+    double t0 = robust_now();
+    check_failure(gmpu_surface_polygonize(s, &m), GMPU_ERROR_LIMIT_EXCEEDED, "GMPU_PARAM_MAX_TRIANGLES = 100");
+    double took = robust_now() - t0;
+    assert_null(m);
+    if (!robust_quick() && took > 2 * full_seconds + 0.5)
+        fail_msg("a cap of 100 triangles at resolution 400 took %.3f s to fail (resolution 40 takes %.3f s)",
+                 took, full_seconds);
+
+    /* Raised again: the same handle meshes. */
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_MAX_TRIANGLES, 2e9));
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_RESOLUTION, 40));
+    assert_ok(gmpu_surface_polygonize(s, &m));
+    assert_int_equal(gmpu_mesh_triangle_count(m), tris);
+    assert_null(robust_mesh_problem(m));
+    gmpu_mesh_destroy(m);
+    gmpu_surface_destroy(s);
+}
+
+static void test_max_depth(void **state) {
+    (void)state;
+    gmpu_surface *s = surface_with_points();
+    assert_ok(gmpu_surface_fit(s));
+    const double natural = stat_of(s, GMPU_STAT_DEPTH);
+    assert_true(natural >= 4);
+    double cells_before = stat_of(s, GMPU_STAT_CELLS);
+    for (int d = 1; d <= (int)natural + 1; ++d) {
+        assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_MAX_DEPTH, d));
+        assert_ok(gmpu_surface_fit(s));
+        double depth = stat_of(s, GMPU_STAT_DEPTH), cells = stat_of(s, GMPU_STAT_CELLS);
+        if (depth != fmin(d, natural)) fail_msg("GMPU_PARAM_MAX_DEPTH %d gave depth %g (natural %g)", d, depth, natural);
+        if (d < natural) assert_true(cells < cells_before);
+        /* Even the coarsest octree gives a closed, outward mesh. */
+        assert_ok(gmpu_surface_orient(s));
+        gmpu_mesh *m = NULL;
+        assert_ok(gmpu_surface_polygonize(s, &m));
+        const char *problem = robust_mesh_problem(m);
+        if (problem) fail_msg("depth %d: %s", d, problem);
+        assert_true(robust_signed_volume(m) > 0);
+        gmpu_mesh_destroy(m);
+    }
+    gmpu_surface_destroy(s);
+}
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_max_cells),
+        cmocka_unit_test(test_max_triangles),
+        cmocka_unit_test(test_max_depth),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
