@@ -2,6 +2,8 @@
 # (they apt-get what is missing first). Everything real lives in meson.build and tests/.
 SHELL := /bin/bash
 PYTHON := /usr/bin/python3
+# rustup's cargo lives here on this kind of machine, whatever PATH the caller has.
+export PATH := $(HOME)/.cargo/bin:$(PATH)
 BUILD := build
 SAN_BUILD := build-sanitize
 SAMPLE := examples/data/bunny.ply
@@ -10,7 +12,7 @@ DEMO_OUT := $(BUILD)/demo/bunny_mesh.ply
 # Debian packages each target needs; `deps-*` installs only the missing ones.
 CORE_PKGS := g++ pkg-config meson ninja-build libeigen3-dev libnanoflann-dev libcmocka-dev
 TEST_PKGS := $(CORE_PKGS) python3-cffi python3-numpy python3-pytest python3-matplotlib \
-             valgrind clang libclang-rt-14-dev nodejs npm
+             valgrind clang libclang-rt-14-dev
 BENCH_PKGS := $(TEST_PKGS) python3-open3d libcgal-dev libgmp-dev libmpfr-dev
 
 define apt_install
@@ -32,6 +34,12 @@ deps:
 
 deps-test:
 	$(call apt_install,$(TEST_PKGS))
+	@# Node.js: the machine's own (NodeSource, with npm) when present; Debian's otherwise.
+	@command -v node >/dev/null && command -v npm >/dev/null || $(MAKE) --no-print-directory deps-node
+
+.PHONY: deps-node
+deps-node:
+	$(call apt_install,nodejs npm)
 
 deps-bench:
 	$(call apt_install,$(BENCH_PKGS))
