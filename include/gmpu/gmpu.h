@@ -21,8 +21,10 @@
  *     out of the solid.
  *   - Thread safety: different handles never share mutable state and may be used from
  *     different threads at once. On one surface handle, functions taking a const pointer
- *     (evaluate, copy_normals, get_param, get_stat, point_count) may run concurrently with
- *     each other; every other call on that handle needs exclusive access.
+ *     (evaluate, copy_normals, get_param, get_stat, point_count, last_error) may run
+ *     concurrently with each other; every other call on that handle needs exclusive
+ *     access. Meshes and point sets never change after creation: all their accessors may
+ *     run concurrently; only destroy needs exclusive access.
  *
  * Parameters and statistics go through gmpu_surface_set_param / gmpu_surface_get_stat with
  * an enum key (as zstd does), so new knobs never change a struct layout. Enum values are
@@ -151,7 +153,9 @@ typedef enum gmpu_stat {
     GMPU_STAT_QUADRIC_CELLS = 5,      /* leaves fitted with a general quadric */
     GMPU_STAT_BIVARIATE_CELLS = 6,    /* leaves fitted with a bivariate quadratic */
     GMPU_STAT_PIECEWISE_CELLS = 7,    /* leaves fitted with piecewise quadrics (edge/corner) */
-    GMPU_STAT_COMPONENTS = 8,         /* connected pieces found by orient */
+    GMPU_STAT_COMPONENTS = 8,         /* connected components of orient's leaf-cell graph: one
+                                       * per separate shape, plus any isolated cells (the
+                                       * mesh's own components may be fewer) */
     GMPU_STAT_FLIPPED_CELLS = 9,      /* leaves whose fitted sign orient reversed */
     GMPU_STAT_FIT_SECONDS = 10,       /* wall time of the last fit */
     GMPU_STAT_ORIENT_SECONDS = 11,

@@ -343,7 +343,7 @@ GMPU_API gmpu_status gmpu_surface_orient(gmpu_surface *s) {
                                                double(s->points.size()) / 0.05);
         gmpu::measure_points(tree, s->points, threads, progress, measures);
         s->measures = std::move(measures);
-        s->winding = gmpu::WindingField(tree, s->points, s->measures.normals, s->measures.area);
+        s->winding = gmpu::WindingField(tree, s->points, s->measures.normals, s->measures.area, &progress);
         progress.report(1.0, true);
         progress.throw_if_cancelled();  // a cancel on the final report counts too
         s->orient_stats = stats;

@@ -42,7 +42,9 @@ void parallel_for(size_t begin, size_t end, unsigned threads, Progress &progress
                 return;
             }
             size_t done = finished.fetch_add(stop - start) + (stop - start);
-            if (is_caller && total > 0) progress.report((done_before + double(done)) / total);
+            // A loop without a share of the bar (total 0) still reports, repeating the last
+            // fraction, so that the callback keeps its 50 ms cadence and can cancel the loop.
+            if (is_caller) progress.report(total > 0 ? (done_before + double(done)) / total : 0.0);
         }
     };
 
@@ -60,7 +62,7 @@ void parallel_for(size_t begin, size_t end, unsigned threads, Progress &progress
     // chunks finish on the other threads.
     while (active.load() > 0) {
         std::this_thread::sleep_for(std::chrono::milliseconds(5));
-        if (total > 0) progress.report((done_before + double(finished.load())) / total);
+        progress.report(total > 0 ? (done_before + double(finished.load())) / total : 0.0);
     }
     for (auto &t : pool) t.join();
     if (failure) std::rethrow_exception(failure);

@@ -25,6 +25,14 @@ public:
     // Throws CANCELLED if the callback asked to stop.
     void throw_if_cancelled() const;
 
+    // report() then throw_if_cancelled(), for serial loops on the calling thread: called once
+    // per item it keeps the callback's cadence (report throttles itself; a clock read is
+    // noise next to an item's work) and stops the loop within one item of a cancel.
+    void poll(double fraction) {
+        report(fraction);
+        throw_if_cancelled();
+    }
+
     gmpu_stage stage() const { return stage_; }
 
 private:

@@ -1,6 +1,7 @@
 #include "fit/build_octree.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <numeric>
 #include <string>
@@ -126,6 +127,13 @@ struct Builder {
         tree.cells.push_back(std::move(c));
     }
 
+    [[noreturn]] void too_many_cells() const {
+        throw Error(GMPU_ERROR_LIMIT_EXCEEDED, "the octree needs more than GMPU_PARAM_MAX_CELLS = " +
+                                                   std::to_string(uint64_t(params.max_cells)) +
+                                                   " cells; raise the cap, raise GMPU_PARAM_ERROR or lower "
+                                                   "GMPU_PARAM_MAX_DEPTH");
+    }
+
     Octree run(Progress &progress) {
         const size_t n = points.size();
         tree.order.resize(n);
@@ -150,9 +158,15 @@ struct Builder {
             // Map this level onto the unsettled part of the progress bar.
             double span = std::max(1e-9, (1.0 - settled) * 0.5);
             double total = double(level.size()) / span;
-            parallel_for(0, level.size(), threads, progress,
-                         [&](size_t i) { kids[i] = make_children(tree.cells[level[i]]); },
-                         settled * total, total, 4);
+            // The cap is checked as children are made, not once the level is done: a level can
+            // hold most of the octree, and would otherwise overshoot the cap up to 8-fold.
+            std::atomic<size_t> made{tree.cells.size()};
+            // One cell per chunk: near the root a cell's fit takes tens of milliseconds, and
+            // the caller reports progress (and sees a cancel) only between chunks.
+            parallel_for(0, level.size(), threads, progress, [&](size_t i) {
+                kids[i] = make_children(tree.cells[level[i]]);
+                if (double(made += kids[i].size()) > params.max_cells) too_many_cells();
+            }, settled * total, total, 1);
             progress.throw_if_cancelled();
 
             std::vector<uint32_t> next;
@@ -170,12 +184,7 @@ struct Builder {
                     append(std::move(k.cell), k.piece);
                 }
             }
-            if (double(tree.cells.size()) > params.max_cells)
-                throw Error(GMPU_ERROR_LIMIT_EXCEEDED,
-                            "the octree needs more than GMPU_PARAM_MAX_CELLS = " +
-                                std::to_string(uint64_t(params.max_cells)) +
-                                " cells; raise the cap, raise GMPU_PARAM_ERROR or lower "
-                                "GMPU_PARAM_MAX_DEPTH");
+            if (double(tree.cells.size()) > params.max_cells) too_many_cells();
             level.swap(next);
             progress.report(settled);
         }

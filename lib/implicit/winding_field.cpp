@@ -10,7 +10,7 @@ constexpr double kInv4Pi = 0.25 / M_PI;
 }  // namespace
 
 WindingField::WindingField(const Octree &tree, const PointSet &points, const std::vector<float> &normals,
-                           const std::vector<float> &area)
+                           const std::vector<float> &area, Progress *progress)
     : tree_(&tree), points_(&points), moments_(tree.cells.size()), weighted_(points.size()) {
     for (size_t k = 0; k < tree.order.size(); ++k) {
         uint32_t i = tree.order[k];
@@ -19,6 +19,7 @@ WindingField::WindingField(const Octree &tree, const PointSet &points, const std
     // Children follow parents, so a reverse sweep could aggregate; a direct pass over each
     // cell's contiguous point range is as simple and costs O(n · depth).
     for (size_t c = 0; c < tree.cells.size(); ++c) {
+        if (progress) progress->poll(0.95 + 0.05 * double(c) / double(tree.cells.size()));
         const Cell &cell = tree.cells[c];
         Moment &m = moments_[c];
         double total = 0.0;

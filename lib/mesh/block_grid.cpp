@@ -82,6 +82,19 @@ void BlockGrid::sign_far_regions(const WindingField &winding) {
         if (!band[size_t(b)]) far_sign[size_t(b)] = region_sign[size_t(region[size_t(b)])];
 }
 
+bool BlockGrid::touches_far(int64_t id) const {
+    int64_t p[3];
+    block_position(id, p);
+    for (int64_t dz = -1; dz <= 1; ++dz)
+        for (int64_t dy = -1; dy <= 1; ++dy)
+            for (int64_t dx = -1; dx <= 1; ++dx) {
+                const int64_t x = p[0] + dx, y = p[1] + dy, z = p[2] + dz;
+                if (x < 0 || y < 0 || z < 0 || x >= blocks[0] || y >= blocks[1] || z >= blocks[2]) continue;
+                if (!band[size_t(block_id(x, y, z))]) return true;
+            }
+    return false;
+}
+
 int8_t BlockGrid::forced_sign(int64_t x, int64_t y, int64_t z) const {
     int64_t lo[3], hi[3];
     const int64_t c[3] = {x, y, z};

@@ -48,6 +48,8 @@ struct BlockGrid {
     // Sign imposed on grid corner (x, y, z) by the far blocks touching it, 0 if none. A
     // function of the corner alone, so every block sharing it agrees.
     int8_t forced_sign(int64_t x, int64_t y, int64_t z) const;
+    // Whether any of the 26 blocks around a band block is far (else no corner is forced).
+    bool touches_far(int64_t id) const;
 
     size_t block_count() const { return band.size(); }
 

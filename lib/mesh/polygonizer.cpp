@@ -69,9 +69,30 @@ void nearby_points(const BlockGrid &g, const PointSet &points, const Eigen::Alig
 //  - otherwise: the far field (a signed distance by the nearby normals), sampled on the
 //    coarse lattice of every fourth corner and interpolated — its sign only matters away
 //    from the data, where it varies slowly, and this costs 1/64 of the neighbour searches.
-void corner_values(const BlockGrid &g, const SurfaceField &f, const std::vector<uint32_t> &leaves,
+// The leaves blending in each of the block's 2³ sub-blocks (closed boxes of 4³ cubes):
+// shorter lists than one for the whole block, so each value scans fewer candidates.
+struct SubBlockLeaves {
+    static constexpr int S = B / 2;
+    std::vector<uint32_t> list[8];
+    void gather(const MpuFunction &mpu, const BlockGrid &g, const int64_t origin[3]) {
+        for (int s = 0; s < 8; ++s) {
+            const Eigen::Vector3d lo = g.corner(origin[0] + S * (s & 1), origin[1] + S * (s >> 1 & 1), origin[2] + S * (s >> 2 & 1));
+            // A hair wider than the sub-block, so a vertex rounded just past its face still
+            // finds every leaf that covers it (an extra candidate changes nothing).
+            const Eigen::Vector3d pad = Eigen::Vector3d::Constant(1e-6 * g.h);
+            mpu.gather(Eigen::AlignedBox3d(lo - pad, lo + Eigen::Vector3d::Constant(S * g.h) + pad), list[s]);
+        }
+    }
+    // For a corner (0..B per axis) or a cube (0..B-1): a sub-block whose box holds it.
+    const std::vector<uint32_t> &at(int i, int j, int k) const {
+        return list[std::min(i / S, 1) | std::min(j / S, 1) << 1 | std::min(k / S, 1) << 2];
+    }
+};
+
+void corner_values(const BlockGrid &g, const SurfaceField &f, const SubBlockLeaves &leaves,
                    const std::vector<uint32_t> &near, const int64_t origin[3], std::vector<double> &value) {
     constexpr int C = B + 1, S = 4, CC = B / S + 1;  // coarse lattice step and size
+    const bool touches_far = g.touches_far(g.block_id(origin[0] / B, origin[1] / B, origin[2] / B));
     auto local = [](int i, int j, int k) { return i + C * (j + C * k); };
 
     // Trust by splatting every nearby point's ball onto the corners.
@@ -107,12 +128,13 @@ void corner_values(const BlockGrid &g, const SurfaceField &f, const std::vector<
     for (int k = 0; k < C; ++k)
         for (int j = 0; j < C; ++j)
             for (int i = 0; i < C; ++i) {
-                const int8_t forced = g.forced_sign(origin[0] + i, origin[1] + j, origin[2] + k);
+                const int8_t forced = touches_far ? g.forced_sign(origin[0] + i, origin[1] + j, origin[2] + k) : 0;
                 double v;
                 if (forced != 0) {
                     v = forced * g.h;
                 } else if (trusted[size_t(local(i, j, k))]) {
-                    v = f.mpu().value_among(leaves, g.corner(origin[0] + i, origin[1] + j, origin[2] + k), nullptr);
+                    v = f.mpu().value_among(leaves.at(i, j, k), g.corner(origin[0] + i, origin[1] + j, origin[2] + k),
+                                            nullptr);
                 } else {
                     // Trilinear in the coarse cell holding the corner.
                     const int ci = std::min(i / S, CC - 2) * S, cj = std::min(j / S, CC - 2) * S,
@@ -136,14 +158,14 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, int64_t block, 
     constexpr int C = B + 1;
     thread_local std::vector<double> value(C * C * C);
     thread_local std::vector<int32_t> slot(C * C * C * 8);
-    thread_local std::vector<uint32_t> leaves;
-    f.mpu().gather(g.block_box(block), leaves);
+    thread_local SubBlockLeaves leaves;
 
     int64_t pos[3];
     g.block_position(block, pos);
     const int64_t x0 = pos[0] * B, y0 = pos[1] * B, z0 = pos[2] * B;
     const int64_t origin[3] = {x0, y0, z0};
     auto local = [](int i, int j, int k) { return i + C * (j + C * k); };
+    leaves.gather(f.mpu(), g, origin);
     // Every point whose trust ball may reach the block.
     thread_local std::vector<uint32_t> near, weight;
     const Eigen::AlignedBox3d box = g.block_box(block);
@@ -162,7 +184,7 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, int64_t block, 
         const Eigen::Vector3d pa = g.corner(x0 + ai, y0 + aj, z0 + ak), pb = g.corner(x0 + bi, y0 + bj, z0 + bk);
         const Eigen::Vector3d p = pa + t * (pb - pa);
         Eigen::Vector3d grad;
-        f.mpu().value_among(leaves, p, &grad);
+        f.mpu().value_among(leaves.at(i, j, k), p, &grad);  // the cube (i, j, k) holds p
         s = int32_t(out.vertex_pos.size());
         out.vertex_pos.push_back(p);
         out.vertex_grad.push_back(grad);
@@ -209,16 +231,29 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, int64_t block, 
 Mesh weld(std::vector<BlockOutput> &blocks, const Normalisation &norm, Progress &progress,
           std::vector<uint32_t> &votes) {
     std::vector<std::pair<uint64_t, uint64_t>> keyed;  // (edge key, block << 32 | local index)
-    for (size_t b = 0; b < blocks.size(); ++b)
+    for (size_t b = 0; b < blocks.size(); ++b) {
+        progress.poll(0.95);
         for (size_t v = 0; v < blocks[b].vertex_key.size(); ++v) keyed.push_back({blocks[b].vertex_key[v], uint64_t(b) << 32 | v});
-    progress.throw_if_cancelled();
-    std::sort(keyed.begin(), keyed.end());
-    progress.throw_if_cancelled();
+    }
+    // Sorted in slices, then merged pass by pass, polling progress in between: one std::sort
+    // of a million keys takes ~100 ms, past the callback's 50 ms cadence (and a cancel).
+    constexpr size_t kSlice = size_t(1) << 15;
+    for (size_t lo = 0; lo < keyed.size(); lo += kSlice) {
+        progress.poll(0.96);
+        std::sort(keyed.begin() + long(lo), keyed.begin() + long(std::min(keyed.size(), lo + kSlice)));
+    }
+    for (size_t width = kSlice; width < keyed.size(); width *= 2)
+        for (size_t lo = 0; lo + width < keyed.size(); lo += 2 * width) {
+            progress.poll(0.96);
+            std::inplace_merge(keyed.begin() + long(lo), keyed.begin() + long(lo + width),
+                               keyed.begin() + long(std::min(keyed.size(), lo + 2 * width)));
+        }
 
     Mesh mesh;
     std::vector<std::vector<uint32_t>> remap(blocks.size());
     for (size_t b = 0; b < blocks.size(); ++b) remap[b].resize(blocks[b].vertex_key.size());
     for (size_t k = 0; k < keyed.size(); ++k) {
+        if (k % 4096 == 0) progress.poll(0.97);
         const size_t b = keyed[k].second >> 32, v = keyed[k].second & 0xffffffffu;
         if (k == 0 || keyed[k].first != keyed[k - 1].first) {
             const Eigen::Vector3d p = norm.to_world(blocks[b].vertex_pos[v]);
@@ -231,8 +266,10 @@ Mesh weld(std::vector<BlockOutput> &blocks, const Normalisation &norm, Progress 
         remap[b][v] = uint32_t(mesh.vertex_count() - 1);
         votes.back() += blocks[b].votes[v];
     }
-    for (size_t b = 0; b < blocks.size(); ++b)
+    for (size_t b = 0; b < blocks.size(); ++b) {
+        progress.poll(0.98);
         for (uint32_t v : blocks[b].triangles) mesh.triangles.push_back(remap[b][v]);
+    }
     return mesh;
 }
 

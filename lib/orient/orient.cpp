@@ -12,11 +12,12 @@ namespace gmpu {
 namespace {
 
 // Signs each leaf by its points' normals: ∇f must point inward, against the normals.
-void sign_leaves_by_normals(Octree &tree, const PointSet &points, const float *normals) {
+void sign_leaves_by_normals(Octree &tree, const PointSet &points, const float *normals, Progress &progress) {
     std::vector<uint32_t> idx;
     std::vector<float> d2;
     Eigen::Vector3d g;
     for (Cell &c : tree.cells) {
+        progress.poll(0.85 * double(&c - tree.cells.data()) / double(tree.cells.size()));  // O(n) in all
         if (!c.is_leaf()) continue;
         idx.assign(tree.order.begin() + c.point_begin, tree.order.begin() + c.point_end);
         if (idx.empty()) points.nearest(c.centre, 8, idx, d2);  // a leaf holding no point
@@ -33,10 +34,11 @@ void sign_leaves_by_normals(Octree &tree, const PointSet &points, const float *n
 // Inner cells follow their oriented children: the sign that makes the cell's gradient
 // agree with theirs at the children's points. Children come after parents, so a reverse
 // sweep sees every child oriented before its parent.
-void sign_inner_cells(Octree &tree, const PointSet &points) {
+void sign_inner_cells(Octree &tree, const PointSet &points, Progress &progress) {
     constexpr uint32_t kSamplesPerChild = 16;
     Eigen::Vector3d gp, gc;
     for (size_t i = tree.cells.size(); i-- > 0;) {
+        progress.poll(0.9 - 0.05 * double(i) / double(tree.cells.size()));  // ~0.2 s a million points
         Cell &c = tree.cells[i];
         if (c.is_leaf()) continue;
         double vote = 0.0;
@@ -66,7 +68,7 @@ OrientStats orient_octree(Octree &tree, const PointSet &points, const float *nor
     OrientStats stats;
     const unsigned threads = resolve_threads(params.threads);
     if (normals) {
-        sign_leaves_by_normals(tree, points, normals);
+        sign_leaves_by_normals(tree, points, normals, progress);
         stats.components = 1;
     } else {
         LeafGraph graph = build_leaf_graph(tree, threads, progress);
@@ -79,10 +81,10 @@ OrientStats orient_octree(Octree &tree, const PointSet &points, const float *nor
             c.sign = label[v];
             c.oriented = true;
         }
-        make_components_outward(tree, points, graph, component, stats.components);
+        make_components_outward(tree, points, graph, component, stats.components, progress);
     }
     progress.throw_if_cancelled();
-    sign_inner_cells(tree, points);
+    sign_inner_cells(tree, points, progress);
     for (const Cell &c : tree.cells) stats.flipped_leaves += c.is_leaf() && c.sign < 0;
     return stats;
 }

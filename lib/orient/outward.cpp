@@ -38,10 +38,11 @@ LeafMoment leaf_moment(const Octree &tree, const PointSet &points, const Cell &c
 }  // namespace
 
 size_t make_components_outward(Octree &tree, const PointSet &points, const LeafGraph &g,
-                               const std::vector<uint32_t> &component, uint32_t count) {
+                               const std::vector<uint32_t> &component, uint32_t count, Progress &progress) {
     std::vector<LeafMoment> moment(g.size());
     std::vector<double> volume(count, 0.0);
     for (uint32_t v = 0; v < g.size(); ++v) {
+        progress.poll(0.8 + 0.04 * double(v) / double(g.size()));  // every point once: O(n)
         moment[v] = leaf_moment(tree, points, tree.cells[g.cell_of[v]]);
         volume[component[v]] += moment[v].volume;
     }
@@ -66,6 +67,7 @@ size_t make_components_outward(Octree &tree, const PointSet &points, const LeafG
         }
         std::vector<int8_t> parity(count, 1);
         for (uint32_t c = 0; c < count; ++c) {
+            progress.poll(0.84 + 0.01 * double(c) / double(count));  // O(count × leaves) in all
             if (!probe_count[c]) continue;
             const Eigen::Vector3d q = probe[c];
             std::vector<double> winding(count, 0.0);

@@ -4,7 +4,8 @@
 //
 //   cgal_peer INPUT.ply OUTPUT_MESH.ply ORIENTED_POINTS.ply
 //
-// Prints one JSON object: seconds per stage and how many points MST left unoriented.
+// Prints one JSON object: seconds per stage, and under "info" how many points MST left
+// unoriented (it orients only the neighbour graph's component holding its seed point).
 // The oriented points are written in the input's order (MST reorders its range), so
 // they can be scored against the *_gt.ply normals point by point.
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
@@ -137,7 +138,8 @@ int main(int argc, char **argv) {
     }
     const double t_write = seconds_since(start);
     std::printf("{\"read\": %.6f, \"normals\": %.6f, \"orient\": %.6f, \"reconstruct\": %.6f, "
-                "\"write\": %.6f, \"points\": %zu, \"unoriented\": %ld, \"spacing\": %.9g}\n",
+                "\"write\": %.6f, \"info\": {\"points\": %zu, \"mst_unoriented\": %ld, "
+                "\"spacing\": %.9g}}\n",
                 t_read, t_normals, t_orient, t_reconstruct, t_write, points.size(),
                 static_cast<long>(unoriented_count), spacing);
     return 0;

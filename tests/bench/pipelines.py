@@ -12,6 +12,7 @@ Run as a script, this file is the Open3D child:
 import json
 import os
 import re
+import signal
 import subprocess
 import sys
 import time
@@ -34,6 +35,7 @@ class Run:
     wall: float = 0.0           # seconds, the child process from start to exit
     peak_rss_mb: float = 0.0    # the child's maximum resident set
     stages: dict = field(default_factory=dict)  # stage name -> seconds
+    info: dict = field(default_factory=dict)    # what else the pipeline reported
     compute: float = 0.0        # sum of the work stages
     error: str = ""
 
@@ -68,7 +70,7 @@ class Pipeline:
         raise NotImplementedError
 
     def stages(self, stdout, log_text):
-        """Seconds per stage from the child's output."""
+        """Seconds per stage (and an "info" dict) from the child's last line of JSON."""
         return json.loads(stdout.strip().splitlines()[-1])
 
     def available(self):
@@ -86,6 +88,8 @@ class Pipeline:
         log_text = log.read_text(errors="replace")
         if code is None:
             run.error = f"timed out after {timeout:.0f} s"
+        elif code < 0:
+            run.error = f"crashed ({signal.Signals(-code).name})"
         elif code != 0:
             run.error = (log_text.strip().splitlines() or [f"exit {code}"])[-1][:300]
         elif not mesh.exists() or not points.exists():
@@ -93,6 +97,7 @@ class Pipeline:
         else:
             try:
                 run.stages = self.stages(stdout, log_text)
+                run.info = run.stages.pop("info", {})
             except (ValueError, IndexError, KeyError) as e:
                 run.error = f"cannot read stage times: {e}"
                 return run

@@ -24,10 +24,13 @@ def fmt(value, spec, scale=1.0):
     return format(value * scale, spec)
 
 
+STAGE_NAMES = ("read", "normals", "fit", "orient", "reconstruct", "polygonize", "write")
+
+
 def stages(row):
-    """'normals 0.21 · orient 3.44 · ...': every timed stage but the total."""
-    return " · ".join(f"{k} {v:.2f}" for k, v in row.get("stages", {}).items()
-                      if isinstance(v, float) and k != "total")
+    """'normals 0.21 · orient 3.44 · ...': every timed stage, in pipeline order."""
+    timed = row.get("stages", {})
+    return " · ".join(f"{k} {timed[k]:.2f}" for k in STAGE_NAMES if k in timed)
 
 
 def by_cloud(rows):

@@ -144,6 +144,7 @@ def run_one(pipeline, cloud, out_dir, metrics_exe, timeout, samples):
     row = {"cloud": cloud.name, "group": cloud.group, "points": cloud.points,
            "pipeline": pipeline.name, "ok": run.ok, "error": run.error, "wall": run.wall,
            "compute": run.compute, "peak_rss_mb": run.peak_rss_mb, "stages": run.stages,
+           "info": run.info,
            "load_before": load, "mesh": str(run.mesh), "cloud_path": str(cloud.path),
            "gt_mesh": str(cloud.gt_mesh) if cloud.gt_mesh else None}
     if run.ok:

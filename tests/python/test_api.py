@@ -233,3 +233,18 @@ def test_context_manager_and_close(small_cloud):
 def test_stage_enum():
     assert [int(s) for s in gmpu.Stage] == [1, 2, 3]
     assert str(gmpu.Stage.POLYGONIZE) == "polygonize"
+
+
+def test_large_queries_are_evaluated_in_chunks_with_the_same_results(oriented, small_cloud, monkeypatch):
+    import gmpu._core
+    pts, _ = small_cloud
+    q = pts[:1000] + 0.002
+    f, g = oriented.evaluate(q, gradient=True)
+    monkeypatch.setattr(gmpu._core, "_EVAL_CHUNK", 7)  # 143 C calls instead of one
+    f7, g7 = oriented.evaluate(q, gradient=True)
+    assert np.array_equal(f, f7) and np.array_equal(g, g7)
+    assert np.array_equal(oriented.gradient(q), g)
+    bad = q.copy()
+    bad[500, 0] = np.inf
+    with pytest.raises(gmpu.InvalidInputError, match="query point 500 "):  # the global index
+        oriented.evaluate(bad)

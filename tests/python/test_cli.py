@@ -13,14 +13,12 @@ measure read → reconstruct → write only; Python's from RUSAGE_SELF, which in
 library's worker threads) and asserts median(Python) ≤ 1.05 × median(CLI). The wall-time
 medians and the library's own stage timings are printed for the record, not asserted.
 """
-import os
 import re
 import resource
 import statistics
 import subprocess
 import time
 
-import numpy as np
 import pytest
 
 import gmpu

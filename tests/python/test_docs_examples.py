@@ -4,8 +4,6 @@ import re
 import struct
 import subprocess
 
-import pytest
-
 import gmpu
 
 from conftest import REPO, SAMPLE, run_python

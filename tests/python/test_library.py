@@ -5,8 +5,6 @@ import os
 import shutil
 import subprocess
 
-import pytest
-
 import gmpu
 from gmpu import _library
 

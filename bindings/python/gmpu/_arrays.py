@@ -58,7 +58,7 @@ def xyz_for_c(a: Any, name: str = "points") -> Tuple[np.ndarray, str, Any, int, 
         # The library rejects NULL even with a zero count; give it a valid empty buffer so the
         # error it reports is the meaningful one (too few points).
         arr = np.zeros((1, 3), arr.dtype)
-    ptr = ffi.cast("double *" if kind == "f64" else "float *", arr.__array_interface__["data"][0])
+    ptr = _pointer(arr, "double" if kind == "f64" else "float")
     return arr, kind, ptr, n, row
 
 
@@ -74,11 +74,25 @@ def queries_for_c(q: Any) -> Tuple[np.ndarray, Tuple[int, ...]]:
     return flat, batch
 
 
+def _pointer(arr: np.ndarray, ctype: str):
+    """A ctype* to arr's first element. For a contiguous array it is a cffi buffer view, which
+    keeps arr alive (and is the cheapest way in); for a strided one, a plain cast of the
+    address, so the caller must keep arr alive during the C call."""
+    if arr.flags.c_contiguous:
+        return ffi.from_buffer(ctype + "[]", arr)
+    return ffi.cast(ctype + " *", arr.__array_interface__["data"][0])
+
+
 def double_ptr(arr: Optional[np.ndarray]):
     """A double* into a C-contiguous float64 array (NULL for None)."""
     if arr is None:
         return ffi.NULL
-    return ffi.cast("double *", arr.__array_interface__["data"][0])
+    return _pointer(arr, "double")
+
+
+def uint32_ptr(arr: np.ndarray):
+    """A uint32_t* into a C-contiguous uint32 array."""
+    return _pointer(arr, "uint32_t")
 
 
 def view_of_c_memory(owner, ptr, shape: Tuple[int, ...], dtype) -> np.ndarray:

@@ -5,15 +5,15 @@ import numbers
 import os
 import threading
 import weakref
-from typing import Any, Dict, Optional, Tuple, Union
+from typing import Any, Dict, Optional, Union
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from ._arrays import _as_real_array, double_ptr, queries_for_c, view_of_c_memory, xyz_for_c
+from ._arrays import _as_real_array, double_ptr, queries_for_c, uint32_ptr, view_of_c_memory, xyz_for_c
 from ._errors import check
 from ._library import ffi, lib
-from ._progress import ProgressFn, Stage, run_with_progress
+from ._progress import ProgressFn, run_with_progress
 
 __all__ = ["Surface", "Mesh", "Points", "reconstruct", "read_points", "PARAMS", "STATS"]
 
@@ -201,8 +201,7 @@ class Mesh:
             return
         out = ffi.new("gmpu_mesh **")
         v, f = self._vertices, self._faces
-        check(lib.gmpu_mesh_create(double_ptr(v), len(v), ffi.cast("uint32_t *", f.__array_interface__["data"][0]),
-                                   len(f), out), "gmpu_mesh_create")
+        check(lib.gmpu_mesh_create(double_ptr(v), len(v), uint32_ptr(f), len(f), out), "gmpu_mesh_create")
         mesh = ffi.gc(out[0], lib.gmpu_mesh_destroy)
         try:
             check(lib.gmpu_mesh_write(mesh, p), "gmpu_mesh_write")

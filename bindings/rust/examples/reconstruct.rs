@@ -2,7 +2,7 @@
 //! the C CLI `gmpu-reconstruct`).
 //!
 //!     cargo run --example reconstruct -- IN.ply OUT.ply [--error E] [--max-depth D]
-//!         [--resolution R] [--level L] [--threads T] [--no-sharp] [--use-normals]
+//!         [--resolution R] [--level L] [--threads T] [--sharp | --no-sharp] [--use-normals]
 //!         [--normals-out POINTS.ply] [--quiet]
 //!
 //! The output format comes from OUT's extension (.ply, .obj, .off). Exit status 0 on
@@ -12,7 +12,7 @@ use std::process::ExitCode;
 use gmpu::{ControlFlow, Param, Points, Stage, Stat, Surface};
 
 const USAGE: &str = "usage: reconstruct IN OUT [--error E] [--max-depth D] [--resolution R] [--level L]
-                   [--threads T] [--no-sharp] [--use-normals] [--normals-out POINTS.ply] [--quiet]
+                   [--threads T] [--sharp | --no-sharp] [--use-normals] [--normals-out POINTS.ply] [--quiet]
   IN   .ply .xyz .txt .off .obj point cloud (normals ignored unless --use-normals)
   OUT  .ply .obj .off mesh (closed, outward-facing)";
 
@@ -47,6 +47,7 @@ fn parse_args(args: &[String]) -> Result<Options, String> {
             "--resolution" => o.params.push((Param::Resolution, value(a)?)),
             "--level" => o.params.push((Param::Level, value(a)?)),
             "--threads" => o.params.push((Param::Threads, value(a)?)),
+            "--sharp" => o.params.push((Param::SharpFeatures, 1.0)),
             "--no-sharp" => o.params.push((Param::SharpFeatures, 0.0)),
             "--use-normals" => o.use_normals = true,
             "--quiet" | "-q" => o.quiet = true,

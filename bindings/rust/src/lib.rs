@@ -273,7 +273,8 @@ key_enum! {
         MinPoints = sys::GMPU_PARAM_MIN_POINTS,
         /// α: support radius = α × cell diagonal (default 0.75, range [0.5, 2]).
         SupportScale = sys::GMPU_PARAM_SUPPORT_SCALE,
-        /// 1 (default): piecewise quadrics at sharp features; 0: smooth models only.
+        /// 1: piecewise quadrics where a small cell straddles a sharp edge or corner;
+        /// 0 (default): smooth models only. Discards a previous fit.
         SharpFeatures = sys::GMPU_PARAM_SHARP_FEATURES,
         /// Polygonize grid cubes along the longest side; 0 (default) picks one; else 8..4096.
         Resolution = sys::GMPU_PARAM_RESOLUTION,
@@ -583,9 +584,7 @@ impl Surface {
     /// [`Status::Cancelled`] within 100 ms, keeping the stages completed before. A panic in
     /// the callback cancels the stage too and is resumed when the call returns; the closure
     /// is not called again during that call.
-    ///
-    /// The report with fraction 1 comes when the stage's work is done: a `Break` (or panic)
-    /// there is too late to cancel, and the call succeeds (the panic is still resumed).
+    /// Every report counts, the final one (fraction 1) included.
     pub fn set_progress<F>(&mut self, callback: F) -> Result<()>
     where
         F: FnMut(Stage, f64) -> ControlFlow<()> + Send + 'static,

@@ -51,6 +51,9 @@ fn reports_usage_and_failures() {
     assert_eq!(run.status.code(), Some(1));
     let stderr = String::from_utf8_lossy(&run.stderr);
     assert!(stderr.contains("GMPU_ERROR_IO"), "{stderr}");
+    let run = Command::new(example()).args(["in.ply", "out.ply", "--sharp", "--bogus"]).output().unwrap();
+    assert_eq!(run.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&run.stderr).contains("unknown option '--bogus'"));
     let run = Command::new(example()).arg(sample()).arg(&out).args(["--resolution", "5", "-q"]).output().unwrap();
     assert_eq!(run.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&run.stderr).contains("GMPU_PARAM_RESOLUTION"));

@@ -176,3 +176,41 @@ fn closures_are_dropped_once() {
     drop(s);
     assert_eq!(drops.load(Ordering::SeqCst), 3, "closure dropped with the surface");
 }
+
+/// A cancel (or a panic) on the final report, fraction 1, still cancels the stage.
+#[test]
+fn the_final_report_can_cancel() {
+    let mut s = Surface::new().unwrap();
+    s.set_param(Param::Threads, 2.0).unwrap();
+    s.set_param(Param::Resolution, 24.0).unwrap();
+    s.set_points(&sphere(2000, [0.0; 3], 1.0)).unwrap();
+    let at_end = |stage: Stage| {
+        move |st: Stage, fraction: f64| {
+            if st == stage && fraction >= 1.0 {
+                ControlFlow::Break(())
+            } else {
+                ControlFlow::Continue(())
+            }
+        }
+    };
+    s.set_progress(at_end(Stage::Fit)).unwrap();
+    assert_eq!(s.fit().unwrap_err().status(), Status::Cancelled);
+    assert_eq!(s.stat(Stat::Cells).unwrap(), 0.0, "a cancelled fit keeps no octree");
+    s.set_progress(at_end(Stage::Orient)).unwrap();
+    s.fit().unwrap();
+    assert_eq!(s.orient().unwrap_err().status(), Status::Cancelled);
+    assert_eq!(s.evaluate(&[[0.0; 3]]).unwrap_err().status(), Status::WrongOrder);
+    s.set_progress(at_end(Stage::Polygonize)).unwrap();
+    s.orient().unwrap();
+    assert_eq!(s.polygonize().unwrap_err().status(), Status::Cancelled);
+
+    s.set_progress(|stage, fraction| {
+        if stage == Stage::Polygonize && fraction >= 1.0 {
+            panic!("at the very end");
+        }
+        ControlFlow::Continue(())
+    })
+    .unwrap();
+    assert!(catch_unwind(AssertUnwindSafe(|| s.polygonize())).is_err(), "the panic was swallowed");
+    assert!(s.last_error().contains("GMPU_ERROR_CANCELLED"), "{:?}", s.last_error());
+}
