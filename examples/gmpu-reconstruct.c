@@ -47,7 +47,8 @@ static int parse_number(const char *flag, const char *text, double *out) {
 
 static int parse_args(int argc, char **argv, options *o) {
     memset(o, 0, sizeof *o);
-    o->error = o->max_depth = o->resolution = o->level = o->threads = -1;
+    /* NAN: not given (a negative value is given, and must reach the library's range check). */
+    o->error = o->max_depth = o->resolution = o->level = o->threads = NAN;
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i];
         const char *next = i + 1 < argc ? argv[i + 1] : NULL;
@@ -148,7 +149,7 @@ static int fail(const char *what) {
 }
 
 static int set(gmpu_surface *s, gmpu_param key, double value) {
-    return value < 0 || gmpu_surface_set_param(s, key, value) == GMPU_OK;
+    return isnan(value) || gmpu_surface_set_param(s, key, value) == GMPU_OK;
 }
 
 int main(int argc, char **argv) {
@@ -169,7 +170,7 @@ int main(int argc, char **argv) {
     if (!set(surface, GMPU_PARAM_ERROR, o.error) || !set(surface, GMPU_PARAM_MAX_DEPTH, o.max_depth) ||
         !set(surface, GMPU_PARAM_RESOLUTION, o.resolution) || !set(surface, GMPU_PARAM_LEVEL, o.level) ||
         !set(surface, GMPU_PARAM_THREADS, o.threads) ||
-        !set(surface, GMPU_PARAM_SHARP_FEATURES, o.sharp ? 1.0 : -1.0)) {
+        !set(surface, GMPU_PARAM_SHARP_FEATURES, o.sharp ? 1.0 : NAN)) {
         rc = fail("bad parameter");
         goto done;
     }

@@ -12,6 +12,7 @@ constexpr size_t kNeighbours = 8;
 // gaps between samples so the trusted shell around the surface has no holes.
 constexpr double kTrustSpacings = 1.5;
 constexpr size_t kSideVotes = 8;
+constexpr double kFarAway = 1e6;  // normalised units: the data spans 1
 // Up to this many points, measure_points searches every point's neighbours.
 constexpr size_t kExactMeasureLimit = 1u << 17;
 }  // namespace
@@ -27,6 +28,12 @@ bool SurfaceField::trusted(const Eigen::Vector3d &x) const {
 }
 
 double SurfaceField::far_value(const Eigen::Vector3d &x, Eigen::Vector3d *gradient) const {
+    // Very far away (where the kd-tree's float distances would overflow), the data is a
+    // point at the origin of the normalised frame: outside, at distance |x|.
+    if (x.norm() > kFarAway) {
+        if (gradient) *gradient = -x.normalized();
+        return -x.norm();
+    }
     // Hoppe's side test, voted over the k nearest points (weighted by closeness) so that
     // one poorly estimated normal — at the tip of a thin part, say — cannot flip a region.
     thread_local std::vector<uint32_t> idx;
@@ -47,7 +54,8 @@ double SurfaceField::far_value(const Eigen::Vector3d &x, Eigen::Vector3d *gradie
     const double distance = std::sqrt(double(d2[0]));
     if (gradient) {
         Eigen::Vector3d away = x - points_.point(idx[0]);
-        *gradient = distance > 0.0 ? Eigen::Vector3d(-sign * away / distance) : Eigen::Vector3d::Zero();
+        // f = sign · distance grows away from the point inside and falls outside.
+        *gradient = distance > 0.0 ? Eigen::Vector3d(sign * away / distance) : Eigen::Vector3d::Zero();
     }
     return sign * distance;
 }

@@ -89,6 +89,15 @@ void sphere(void **) {
         assert_true(g.normalized().dot(Vec3(-1, 0, 0)) > 0.99);
         assert_true(g.norm() > 0.8 && g.norm() < 1.25);
     }
+    // Far from the data too (the far field, and beyond the kd-tree's float range), ∇f
+    // points towards the solid, where f grows.
+    const Vec3 centre(0.2, -0.1, 0.3);
+    std::vector<Vec3> far = {{3, -0.1, 0.3}, {0.2, -4, 0.3}, {1e25, 2e25, -1e25}};
+    f = r.evaluate(far, &grads);
+    for (size_t i = 0; i < far.size(); ++i) {
+        assert_true(f[i] < 0 && std::isfinite(f[i]));
+        assert_true(grads[i].normalized().dot((centre - far[i]).normalized()) > 0.9);
+    }
 }
 
 void torus(void **) {

@@ -248,3 +248,14 @@ def test_large_queries_are_evaluated_in_chunks_with_the_same_results(oriented, s
     bad[500, 0] = np.inf
     with pytest.raises(gmpu.InvalidInputError, match="query point 500 "):  # the global index
         oriented.evaluate(bad)
+
+
+def test_gradient_matches_finite_differences_away_from_the_data(oriented, small_cloud):
+    diag = oriented.stats["bbox_diagonal"]
+    dirs = np.random.default_rng(3).normal(size=(8, 3))
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    q = small_cloud[0].mean(0) + 0.6 * diag * dirs  # outside, beyond the band around the data
+    assert (oriented.evaluate(q) < 0).all()
+    h = 1e-6 * diag
+    num = np.stack([(oriented.evaluate(q + h * e) - oriented.evaluate(q - h * e)) / (2 * h) for e in np.eye(3)], 1)
+    assert np.allclose(oriented.gradient(q), num, atol=0.05)

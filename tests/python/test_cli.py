@@ -23,7 +23,7 @@ import pytest
 
 import gmpu
 
-PAIRS = 5
+PAIRS = 7
 TIME_LINE = re.compile(r"gmpu: time (.*)")
 
 

@@ -200,3 +200,11 @@ def test_file_errors(tmp_path):
     with pytest.raises(gmpu.IoError):
         gmpu.reconstruct(tmp_path / "missing.xyz")
     assert not list(tmp_path.glob("*.tmp*"))
+
+
+def test_set_params_is_all_or_nothing(oriented):
+    before = oriented.params
+    cells = oriented.stats["cells"]
+    with pytest.raises(gmpu.InvalidArgumentError, match="GMPU_PARAM_MAX_DEPTH"):
+        oriented.set_params(error=0.01, max_depth=99)
+    assert oriented.params == before and oriented.stats["cells"] == cells  # the fit was kept

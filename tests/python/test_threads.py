@@ -40,9 +40,15 @@ def _largest_stall(work):
     return max(b - a for a, b in zip(inside, inside[1:])), t1 - t0
 
 
-def test_gil_is_released_during_fit(bunny_gt):
+def _big_cloud(bunny_gt, copies=4):
+    """Copies of the 35k bunny side by side: enough work for a C call to last a while."""
     pts = bunny_gt.positions
-    with gmpu.Surface(pts, error=0.0005, threads=1) as s:
+    step = 1.5 * (pts.max(0) - pts.min(0))[0]
+    return np.concatenate([pts + [i * step, 0, 0] for i in range(copies)])
+
+
+def test_gil_is_released_during_fit(bunny_gt):
+    with gmpu.Surface(_big_cloud(bunny_gt), error=0.0005, threads=1) as s:
         stall, duration = _largest_stall(s.fit)
         assert s.stats["cells"] > 0
     assert duration > 0.1, "the fit was too short to tell"
@@ -50,7 +56,7 @@ def test_gil_is_released_during_fit(bunny_gt):
 
 
 def test_gil_is_released_during_evaluate(bunny_gt, oriented):
-    q = np.ascontiguousarray(bunny_gt.positions[:60000] + 1e-3)  # one C call (below the chunk size)
+    q = _big_cloud(bunny_gt, 2)[:60000] + 1e-3  # one C call (below the chunk size)
     stall, duration = _largest_stall(lambda: oriented.evaluate(q))
     assert duration > 0.1, "the evaluation was too short to tell"
     assert stall < 0.5 * duration, f"Python stalled {stall:.3f} s during a {duration:.3f} s evaluate"

@@ -313,6 +313,7 @@ class Surface:
         (parameter out of range), gmpu.InvalidInputError (NaN/inf, too few points, normals
         count), gmpu.DegenerateInputError (points bound no volume)."""
         self._ptr = None
+        self._points = 0
         self._lock = _RWLock()
         #: Default progress callable for fit/orient/polygonize: f(stage, fraction).
         self.progress: Optional[ProgressFn] = progress
@@ -357,7 +358,7 @@ class Surface:
     def __repr__(self) -> str:
         if self._ptr is None:
             return "<gmpu.Surface (closed)>"
-        return f"<gmpu.Surface {self.point_count} points>"
+        return f"<gmpu.Surface {self._points} points>"  # no C call: safe from anywhere
 
     def _live(self):
         if self._ptr is None:
@@ -388,6 +389,7 @@ class Surface:
         fn = lib.gmpu_surface_set_points_f64 if kind == "f64" else lib.gmpu_surface_set_points_f32
         name = "gmpu_surface_set_points_" + kind
         self._write(lambda s: check(fn(s, ptr, count, stride), name))
+        self._points = count
         del arr  # kept alive until here: the library copies during the call
 
     def set_normals(self, normals: ArrayLike) -> None:
@@ -406,11 +408,20 @@ class Surface:
         if not items:
             return
 
-        def body(s):
+        def apply(s):
             for key, name, value in items:
                 check(lib.gmpu_surface_set_param(s, key, value), f"gmpu_surface_set_param({name})")
 
-        self._write(body)
+        if len(items) > 1:
+            # All or nothing: validate on a scratch surface first (ranges are all the library
+            # checks), so that a bad value never leaves the real one half-updated.
+            out = ffi.new("gmpu_surface **")
+            check(lib.gmpu_surface_create(out), "gmpu_surface_create")
+            try:
+                apply(out[0])
+            finally:
+                lib.gmpu_surface_destroy(out[0])
+        self._write(apply)
 
     def get_param(self, name: str) -> Union[int, float, bool]:
         """The current value of one parameter."""
