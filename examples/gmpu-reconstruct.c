@@ -224,7 +224,7 @@ int main(int argc, char **argv) {
         gmpu_surface_get_stat(surface, GMPU_STAT_POLYGONIZE_SECONDS, &poly);
         gmpu_surface_get_stat(surface, GMPU_STAT_RESOLUTION, &res);
         fprintf(stderr,
-                "gmpu: %zu points, %.0f cells (%.0f leaves, depth %.0f), %.0f component%s\n"
+                "gmpu: %zu points, %.0f cells (%.0f leaves, depth %.0f) in %.0f connected group%s\n"
                 "gmpu: estimated noise %.3f%% of the diagonal, fitted to error %.3f%%\n"
                 "gmpu: mesh %zu vertices, %zu triangles at resolution %.0f -> %s\n"
                 "gmpu: time read %.3f s, fit %.3f s, orient %.3f s, polygonize %.3f s, write %.3f s, "
