@@ -4,6 +4,7 @@
 // the call modifies a handle, for that handle's last_error too.
 #pragma once
 
+#include <cstring>
 #include <new>
 #include <string>
 
@@ -17,6 +18,17 @@ void record_error(gmpu_status status, const char *message, std::string *handle_e
 
 // Message of this thread's last failure ("" if none).
 const char *thread_error() noexcept;
+
+// The int a C caller passed for an enum (gmpu_param, gmpu_stat, gmpu_status). C allows any
+// int there (a key of a newer header, say); in C++, loading an enum outside its enumerators'
+// range is undefined, so the bits are read as an int and checked before the enum is used.
+template <class E>
+int enum_int(const E &e) noexcept {
+    static_assert(sizeof(E) == sizeof(int), "C enums are int-sized");
+    int v;
+    std::memcpy(&v, &e, sizeof v);
+    return v;
+}
 
 // Throws INVALID_ARGUMENT naming the parameter when p is null.
 template <class T>

@@ -11,7 +11,7 @@ static_assert(GMPU_VERSION_NUMBER ==
 extern "C" {
 
 GMPU_API const char *gmpu_status_name(gmpu_status status) {
-    switch (status) {
+    switch (gmpu::api::enum_int(status)) {  // any int may come from C (see enum_int)
         case GMPU_OK: return "GMPU_OK";
         case GMPU_ERROR_INVALID_ARGUMENT: return "GMPU_ERROR_INVALID_ARGUMENT";
         case GMPU_ERROR_INVALID_INPUT: return "GMPU_ERROR_INVALID_INPUT";

@@ -68,6 +68,18 @@ struct ParamSpec {
     const char *name;
 };
 
+// Unknown keys are rejected as ints, before the enum is loaded (see enum_int).
+void check_key(const gmpu_param &key) {
+    const int v = gmpu::api::enum_int(key);
+    if (v < GMPU_PARAM_ERROR || v > GMPU_PARAM_NOISE_SCALE)  // the first and the last key
+        throw Error(GMPU_ERROR_INVALID_ARGUMENT, "unknown parameter key " + std::to_string(v));
+}
+void check_key(const gmpu_stat &key) {
+    const int v = gmpu::api::enum_int(key);
+    if (v < GMPU_STAT_POINTS || v > GMPU_STAT_EFFECTIVE_ERROR)  // the first and the last key
+        throw Error(GMPU_ERROR_INVALID_ARGUMENT, "unknown statistic key " + std::to_string(v));
+}
+
 ParamSpec spec(gmpu_param key) {
     switch (key) {
         case GMPU_PARAM_ERROR: return {0.0, 1.0, false, true, "GMPU_PARAM_ERROR"};
@@ -214,6 +226,7 @@ GMPU_API const char *gmpu_surface_last_error(const gmpu_surface *s) { return s ?
 GMPU_API gmpu_status gmpu_surface_set_param(gmpu_surface *s, gmpu_param key, double value) {
     return guarded(s ? &s->last_error : nullptr, [&] {
         require_arg(s, "surface");
+        check_key(key);
         gmpu::Params p = s->params;
         set_param(p, key, value);
         if (spec(key).refits && get_param(p, key) != get_param(s->params, key)) s->discard_fit();
@@ -225,6 +238,7 @@ GMPU_API gmpu_status gmpu_surface_get_param(const gmpu_surface *s, gmpu_param ke
     return guarded(nullptr, [&] {
         require_arg(s, "surface");
         require_arg(value, "value");
+        check_key(key);
         *value = get_param(s->params, key);
     });
 }
@@ -233,6 +247,7 @@ GMPU_API gmpu_status gmpu_surface_get_stat(const gmpu_surface *s, gmpu_stat key,
     return guarded(nullptr, [&] {
         require_arg(s, "surface");
         require_arg(value, "value");
+        check_key(key);
         const auto &cells = s->tree.cells;
         auto leaves_where = [&](auto pred) {
             double n = 0;

@@ -43,8 +43,11 @@ struct Builder {
         c.radius = support_radius(c.size);
         // Coarse cells of a big cloud: their support holds a large share of all points, and
         // a uniform subsample of it fits as well (the fit uses 2048 points at most anyway).
-        points.coarse_within(c.centre, c.radius, idx);
-        const double estimate = double(idx.size()) * points.coarse_ratio();
+        double estimate = 0.0;
+        if (points.coarse_ratio() > 1.0) {
+            points.coarse_within(c.centre, c.radius, idx);
+            estimate = double(idx.size()) * points.coarse_ratio();
+        }
         if (estimate <= kFullSupport) {
             idx.clear();
             points.within(c.centre, c.radius, idx);

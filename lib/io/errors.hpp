@@ -23,11 +23,23 @@ inline std::string system_reason(int err) {
 }
 
 // A token from the file, quoted for a message and cut short: hostile files may hold
-// megabyte-long "numbers".
+// megabyte-long "numbers". Bytes other than printable ASCII are shown as \xNN, so that the
+// message stays one line of valid UTF-8 (bindings decode it, terminals print it).
 inline std::string quoted(std::string_view token) {
     constexpr size_t max_shown = 40;
-    if (token.size() <= max_shown) return "'" + std::string(token) + "'";
-    return "'" + std::string(token.substr(0, max_shown)) + "...'";
+    static const char hex[] = "0123456789abcdef";
+    std::string out = "'";
+    for (size_t i = 0; i < token.size() && i < max_shown; ++i) {
+        const unsigned char c = static_cast<unsigned char>(token[i]);
+        if (c >= 0x20 && c < 0x7f) {
+            out += char(c);
+        } else {
+            out += "\\x";
+            out += hex[c >> 4];
+            out += hex[c & 15];
+        }
+    }
+    return out + (token.size() > max_shown ? "...'" : "'");
 }
 
 }  // namespace gmpu::io::detail

@@ -216,7 +216,7 @@ public:
 private:
     size_t left() const { return static_cast<size_t>(end_ - p_); }
     [[noreturn]] void truncated(const Element &e, uint64_t done) const {
-        std::string what = e.name == "vertex" ? "vertices" : "'" + e.name + "' elements";
+        std::string what = e.name == "vertex" ? "vertices" : quoted(e.name) + " elements";
         fail(GMPU_ERROR_PARSE, name_, "expected " + std::to_string(e.count) + " " + what +
                                           ", file ends after " + std::to_string(done));
     }
@@ -290,7 +290,7 @@ bool Body::record(const Element &e, const Wanted &w, double *out, int list_prop,
             p_ += sz;
         }
         if (len_value < 0)
-            fail(GMPU_ERROR_PARSE, name_, "'" + e.name + "' " + std::to_string(item) + ": negative list length");
+            fail(GMPU_ERROR_PARSE, name_, quoted(e.name) + " " + std::to_string(item) + ": negative list length");
         const uint64_t len = static_cast<uint64_t>(len_value);
         const size_t item_size = size_of(p.type);
         // Bounds first: the length is the file's claim, not a fact.

@@ -9,6 +9,7 @@
 #include "mesh/block_grid.hpp"
 #include "mesh/marching_tetrahedra.hpp"
 #include "mesh/mesh_cleanup.hpp"
+#include "mesh/point_buckets.hpp"
 
 namespace gmpu {
 
@@ -27,40 +28,6 @@ struct BlockOutput {
     std::vector<uint32_t> triangles;          // block-local vertex indices
     std::vector<uint32_t> votes;              // per vertex: input points in the block nearest to it
 };
-
-// The points whose trust ball may reach the block, thinned to one representative (the
-// lowest index) per voxel of half a cube, with how many points each stands for. Dense
-// clouds have tens of points per cube; their union of trust balls (at least two cubes
-// wide) hardly changes. The search reaches a voxel diagonal further so that every voxel
-// it touches is wholly inside: the representative of a voxel is then the same whichever
-// block looks, as a corner's value must be.
-void nearby_points(const BlockGrid &g, const PointSet &points, const Eigen::AlignedBox3d &box, double widest_trust,
-                   std::vector<uint32_t> &near, std::vector<uint32_t> &weight) {
-    thread_local std::vector<std::pair<uint64_t, uint32_t>> keyed;
-    thread_local std::vector<uint32_t> found;
-    const double voxel = 0.5 * g.h;
-    found.clear();
-    points.within(box.center(), 0.5 * std::sqrt(3.0) * B * g.h + widest_trust * (1.0 + 1e-5) + std::sqrt(3.0) * voxel + 1e-7,
-                  found);
-    keyed.clear();
-    for (uint32_t i : found) {
-        const Eigen::Vector3d v = (points.point(i) - g.origin) / voxel;
-        const uint64_t key = uint64_t(std::max(0.0, v[0])) | uint64_t(std::max(0.0, v[1])) << 21 |
-                             uint64_t(std::max(0.0, v[2])) << 42;
-        keyed.push_back({key, i});
-    }
-    std::sort(keyed.begin(), keyed.end());
-    near.clear();
-    weight.clear();
-    for (size_t k = 0; k < keyed.size(); ++k) {
-        if (k > 0 && keyed[k].first == keyed[k - 1].first) {
-            ++weight.back();
-            continue;
-        }
-        near.push_back(keyed[k].second);
-        weight.push_back(1);
-    }
-}
 
 // Values at the (B+1)³ corners of one band block. Each corner's value depends on its
 // position alone (never on the block), so neighbouring blocks agree on shared corners:
@@ -90,29 +57,39 @@ struct SubBlockLeaves {
 };
 
 void corner_values(const BlockGrid &g, const SurfaceField &f, const SubBlockLeaves &leaves,
-                   const std::vector<uint32_t> &near, const int64_t origin[3], std::vector<double> &value) {
+                   const uint32_t *near, size_t near_count, const int64_t origin[3], std::vector<double> &value) {
     constexpr int C = B + 1, S = 4, CC = B / S + 1;  // coarse lattice step and size
     const bool touches_far = g.touches_far(g.block_id(origin[0] / B, origin[1] / B, origin[2] / B));
     auto local = [](int i, int j, int k) { return i + C * (j + C * k); };
 
-    // Trust by splatting every nearby point's ball onto the corners.
+    // Trust by splatting every nearby point's ball onto the corners. Ranges are a corner
+    // wider than the ball's box so rounding never decides; the squared-distance test does,
+    // on corner coordinates computed exactly as g.corner() does, the same in every block.
     thread_local std::vector<uint8_t> trusted(C * C * C);
     std::fill(trusted.begin(), trusted.end(), 0);
-    const Eigen::Vector3d lo = g.corner(origin[0], origin[1], origin[2]);
-    for (uint32_t p : near) {
+    double axis[3][C];
+    for (int d = 0; d < 3; ++d)
+        for (int i = 0; i < C; ++i) axis[d][i] = g.origin[d] + g.h * double(origin[d] + i);
+    for (size_t n = 0; n < near_count; ++n) {
+        const uint32_t p = near[n];
         const Eigen::Vector3d q = f.points().point(p);
-        const double r = f.trust_radius(p);
+        const double r = f.trust_radius(p), r2 = r * r;
         int a[3], b[3];
         for (int d = 0; d < 3; ++d) {
-            a[d] = std::max(0, int(std::ceil((q[d] - r - lo[d]) / g.h)));
-            b[d] = std::min(B, int(std::floor((q[d] + r - lo[d]) / g.h)));
+            a[d] = std::max(0, int(std::floor((q[d] - r - axis[d][0]) / g.h)));
+            b[d] = std::min(B, int(std::ceil((q[d] + r - axis[d][0]) / g.h)));
         }
-        for (int k = a[2]; k <= b[2]; ++k)
-            for (int j = a[1]; j <= b[1]; ++j)
+        for (int k = a[2]; k <= b[2]; ++k) {
+            const double dz = axis[2][k] - q[2];
+            for (int j = a[1]; j <= b[1]; ++j) {
+                const double dy = axis[1][j] - q[1], dyz = dy * dy + dz * dz;
+                if (dyz > r2) continue;
                 for (int i = a[0]; i <= b[0]; ++i) {
-                    uint8_t &t = trusted[size_t(local(i, j, k))];
-                    if (!t && (g.corner(origin[0] + i, origin[1] + j, origin[2] + k) - q).norm() <= r) t = 1;
+                    const double dx = axis[0][i] - q[0];
+                    if (dx * dx + dyz <= r2) trusted[size_t(local(i, j, k))] = 1;
                 }
+            }
+        }
     }
 
     double coarse[CC * CC * CC];
@@ -154,7 +131,9 @@ void corner_values(const BlockGrid &g, const SurfaceField &f, const SubBlockLeav
 }
 
 // Marching tetrahedra over one band block.
-void polygonize_block(const BlockGrid &g, const SurfaceField &f, int64_t block, BlockOutput &out) {
+void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuckets &buckets, const std::vector<int64_t> &band,
+                      size_t band_index, BlockOutput &out) {
+    const int64_t block = band[band_index];
     constexpr int C = B + 1;
     thread_local std::vector<double> value(C * C * C);
     thread_local std::vector<int32_t> slot(C * C * C * 8);
@@ -166,11 +145,12 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, int64_t block, 
     const int64_t origin[3] = {x0, y0, z0};
     auto local = [](int i, int j, int k) { return i + C * (j + C * k); };
     leaves.gather(f.mpu(), g, origin);
-    // Every point whose trust ball may reach the block.
-    thread_local std::vector<uint32_t> near, weight;
+    // Every (representative) point whose trust ball reaches the block.
+    const uint32_t *near = buckets.point.data() + buckets.begin(band_index);
+    const uint32_t *weight = buckets.weight.data() + buckets.begin(band_index);
+    const size_t near_count = buckets.end(band_index) - buckets.begin(band_index);
     const Eigen::AlignedBox3d box = g.block_box(block);
-    nearby_points(g, f.points(), box, f.widest_trust(), near, weight);
-    corner_values(g, f, leaves, near, origin, value);
+    corner_values(g, f, leaves, near, near_count, origin, value);
     std::fill(slot.begin(), slot.end(), -1);
 
     auto vertex = [&](int i, int j, int k, const mt::Edge &e) -> uint32_t {
@@ -213,7 +193,7 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, int64_t block, 
     // data collects the votes, bubbles away from it none (see remove_unsupported_components).
     out.votes.assign(out.vertex_pos.size(), 0);
     if (out.vertex_pos.empty()) return;
-    for (size_t n = 0; n < near.size(); ++n) {
+    for (size_t n = 0; n < near_count; ++n) {
         const Eigen::Vector3d q = f.points().point(near[n]);
         if (!(q.array() >= box.min().array()).all() || !(q.array() < box.max().array()).all()) continue;
         size_t best = 0;
@@ -301,11 +281,13 @@ Mesh polygonize(const MpuFunction &mpu, const WindingField &winding, const Point
     progress.report(0.02);
     progress.throw_if_cancelled();
 
+    const PointBuckets buckets(g, band, f);
+    progress.throw_if_cancelled();
     std::vector<BlockOutput> blocks(band.size());
     std::atomic<uint64_t> triangles{0};
     const double total = double(band.size()) / 0.93;
     parallel_for(0, band.size(), resolve_threads(params.threads), progress, [&](size_t i) {
-        polygonize_block(g, f, band[i], blocks[i]);
+        polygonize_block(g, f, buckets, band, i, blocks[i]);
         const uint64_t made = blocks[i].triangles.size() / 3;
         if (double(triangles.fetch_add(made) + made) > params.max_triangles)
             throw Error(GMPU_ERROR_LIMIT_EXCEEDED,
