@@ -1,5 +1,5 @@
 """The reconstruction pipelines the benchmark compares, each run as a child process so that
-its wall time and peak memory are its own (wait4's rusage of that child alone).
+its wall time and peak memory are its own.
 
 A pipeline turns an unoriented cloud into a mesh and per-point oriented normals (same
 points, same order) and reports seconds per stage. `compute` is the sum of the stages
@@ -20,6 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 PYTHON = "/usr/bin/python3"  # Debian's, with numpy and open3d (the first on PATH may lack them)
+TIME = "/usr/bin/time"       # GNU time (Debian's `time`), for each child's peak memory
 HERE = Path(__file__).resolve().parent
 
 # Open3D: neighbours for PCA normals and for the tangent-plane MST (its docs use 30 / k).
@@ -41,25 +42,30 @@ class Run:
 
 
 def run_child(cmd, timeout, log_path):
-    """Runs cmd; returns (exit code or None on timeout, wall seconds, peak RSS in MB, stdout).
-    stderr goes to log_path. Peak RSS comes from wait4 on this child only."""
-    out_path = Path(str(log_path) + ".out")
+    """Runs cmd; returns (exit code, negative for a signal, or None on timeout; wall seconds;
+    peak RSS in MB; stdout). stderr goes to log_path.
+
+    Peak RSS comes from GNU time wrapped around cmd, not from our own wait4: Linux keeps a
+    process's peak across exec, so a child forked from this Python process would report at
+    least this process's own size (~35 MB). time is small, so its child starts from ~1 MB."""
+    out_path, rss_path = Path(f"{log_path}.out"), Path(f"{log_path}.rss")
     start = time.perf_counter()
     with open(out_path, "w") as out, open(log_path, "w") as log:
-        proc = subprocess.Popen(cmd, stdout=out, stderr=log)
-        while True:  # poll, so that a timeout can kill it
-            pid, status, usage = os.wait4(proc.pid, os.WNOHANG)
-            if pid:
-                break
-            if time.perf_counter() - start > timeout:
-                proc.kill()
-                _, status, usage = os.wait4(proc.pid, 0)
-                proc.returncode = -9
-                return None, time.perf_counter() - start, usage.ru_maxrss / 1024, ""
-            time.sleep(0.01)
+        proc = subprocess.Popen([TIME, "-f", "%M", "-o", str(rss_path), *cmd], stdout=out,
+                                stderr=log, start_new_session=True)
+        try:
+            proc.wait(timeout=timeout)
+        except subprocess.TimeoutExpired:
+            os.killpg(proc.pid, signal.SIGKILL)  # time and the pipeline under it
+            proc.wait()
+            return None, time.perf_counter() - start, 0.0, ""
     wall = time.perf_counter() - start
-    proc.returncode = os.waitstatus_to_exitcode(status)
-    return proc.returncode, wall, usage.ru_maxrss / 1024, out_path.read_text(errors="replace")
+    report = rss_path.read_text().split() if rss_path.exists() else []
+    peak_mb = int(report[-1]) / 1024 if report and report[-1].isdigit() else 0.0
+    code = proc.returncode
+    if "signal" in report:  # "Command terminated by signal 11"
+        code = -int(report[report.index("signal") + 1])
+    return code, wall, peak_mb, out_path.read_text(errors="replace")
 
 
 class Pipeline:

@@ -18,10 +18,10 @@ def label(name):
     return PIPELINE_LABELS.get(name, name)
 
 
-def fmt(value, spec, scale=1.0):
+def fmt(value, spec):
     if value is None or (isinstance(value, float) and not math.isfinite(value)):
         return "–"
-    return format(value * scale, spec)
+    return format(value, spec)
 
 
 STAGE_NAMES = ("read", "normals", "fit", "orient", "reconstruct", "polygonize", "write")
@@ -62,7 +62,7 @@ def results_table(rows):
             continue
         lines.append(
             f"| {r['cloud']} | {label(r['pipeline'])} | {fmt(r.get('orientation_accuracy'), '.2%')} "
-            f"| {fmt(r.get('chamfer_l1'), '.3f', 100)}% | {fmt(r.get('fscore_0.5'), '.3f')} "
+            f"| {fmt(r.get('chamfer_l1'), '.3%')} | {fmt(r.get('fscore_0.5'), '.3f')} "
             f"| {fmt(r.get('fscore_1'), '.3f')} | {fmt(r.get('normal_consistency'), '.3f')} "
             f"| {'yes' if r.get('watertight') else 'no'} | {r.get('components', '–')} "
             f"| {r['compute']:.2f} | {r['wall']:.2f} | {r['peak_rss_mb']:.0f} | {stages(r)} |")
@@ -117,7 +117,7 @@ def summary_table(rows):
             return statistics.fmean(vals) if vals else None
         lines.append(
             f"| {label(name)} | {len(ok)}/{len(mine)} | {fmt(statistics.fmean(orient), '.2%')} "
-            f"| {fmt(min(orient), '.2%')} | {fmt(mean('chamfer_l1'), '.3f', 100)}% "
+            f"| {fmt(min(orient), '.2%')} | {fmt(mean('chamfer_l1'), '.3%')} "
             f"| {fmt(mean('fscore_0.5'), '.3f')} | {fmt(mean('fscore_1'), '.3f')} "
             f"| {sum(bool(r.get('watertight')) for r in ok)}/{len(ok)} "
             f"| {statistics.median(r['compute'] for r in ok):.2f} "
@@ -300,7 +300,6 @@ def write_all(results, out_dir, renders=True):
     m = results["machine"]
     machine = (f"{m['cpu']}, {m['cores']} cores, {m['memory_gb']} GB, {m['os']}; run {m['date']}")
     summary = (
-        "## Benchmark: gmpu beside Open3D and CGAL\n\n"
         f"Measured on {machine}. Every number below comes from one run of `make bench`, gmpu "
         "and the peers side by side; distances are exact point-to-triangle, relative to the "
         "ground truth's bounding-box diagonal, 100k samples per surface; orientation is the "
@@ -316,7 +315,7 @@ def write_all(results, out_dir, renders=True):
         + "### Pictures (red: a surface seen from inside, i.e. inside-out)\n\n"
         + "".join(f"[{p.stem}](renders/{p.name}) " for p in pictures) + "\n")
     (out_dir / "summary.md").write_text(summary)
-    full = (summary +
+    full = ("# gmpu beside Open3D and CGAL: benchmark results\n\n" + summary +
             "\n## Every run\n\n" + results_table(rows) +
             "\n## Ratios gmpu / peer, same run\n\n" + ratio_table(rows))
     (out_dir / "results.md").write_text(full)

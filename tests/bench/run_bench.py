@@ -277,6 +277,8 @@ def main():
     # spinning, 3.5 s passive, measured here under load). Each row records the load.
     os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
     args.out.mkdir(parents=True, exist_ok=True)
+    if not Path(pipelines.TIME).exists():
+        sys.exit(f"{pipelines.TIME} is missing (Debian package `time`): it measures peak memory")
     metrics_exe = args.build / "tests" / "bench" / "gmpu-metrics"
     if not metrics_exe.exists():
         sys.exit(f"{metrics_exe} is missing: build first (make build)")
