@@ -383,6 +383,9 @@ GMPU_API gmpu_status gmpu_surface_evaluate(const gmpu_surface *s, const double *
         Eigen::Vector3d g;
         for (size_t i = 0; i < count; ++i) {
             Eigen::Vector3d q = norm.to_unit(Eigen::Vector3d(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]));
+            // A finite query can normalise to inf (1e300 against a cloud at 1e-30), and f and
+            // ∇f would be inf and NaN. Beyond 1e15 box lengths f is the far value anyway.
+            q = q.cwiseMax(-1e15).cwiseMin(1e15);
             double v = f.value(q, gradients ? &g : nullptr);
             if (values) values[i] = v / norm.scale;
             if (gradients)

@@ -191,6 +191,15 @@ struct Builder {
             level.swap(next);
             progress.report(settled);
         }
+        // Subtree reach, children before parents (they come later in the array).
+        for (size_t i = tree.cells.size(); i-- > 0;) {
+            Cell &c = tree.cells[i];
+            c.reach = std::max(c.reach, c.radius);
+            if (c.parent >= 0) {
+                Cell &p = tree.cells[size_t(c.parent)];
+                p.reach = std::max(p.reach, (c.centre - p.centre).norm() + c.reach);
+            }
+        }
         progress.report(1.0, true);
         return std::move(tree);
     }

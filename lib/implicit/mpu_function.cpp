@@ -15,18 +15,22 @@ uint32_t MpuFunction::collect(const Eigen::Vector3d &x, std::vector<uint32_t> &o
     uint32_t deepest = 0;
     uint32_t stack[8 * (kMaxDepth + 2)];
     int top = 0;
-    if (covers(tree_.cells[0], x)) stack[top++] = 0;
+    stack[top++] = 0;
     while (top > 0) {
         const uint32_t i = stack[--top];
         const Cell &c = tree_.cells[i];
-        if (c.depth >= tree_.cells[deepest].depth) deepest = i;
+        // A subtree may hold covering leaves even where its root's own ball does not reach
+        // (grown supports), so the walk prunes on the subtree's reach.
+        if ((x - c.centre).squaredNorm() >= c.reach * c.reach) continue;
+        const bool own = covers(c, x);
+        if (own && c.depth >= tree_.cells[deepest].depth) deepest = i;
         if (is_leaf(c)) {
-            out.push_back(i);
+            if (own) out.push_back(i);
             continue;
         }
         for (int o = 0; o < 8; ++o) {
             int32_t k = tree_.child(c, o);
-            if (k >= 0 && covers(tree_.cells[size_t(k)], x)) stack[top++] = uint32_t(k);
+            if (k >= 0) stack[top++] = uint32_t(k);
         }
     }
     return deepest;
@@ -78,9 +82,10 @@ void MpuFunction::gather(const Eigen::AlignedBox3d &box, std::vector<uint32_t> &
         const uint32_t i = stack.back();
         stack.pop_back();
         const Cell &c = tree_.cells[i];
-        if (box.squaredExteriorDistance(c.centre) >= c.radius * c.radius) continue;
+        const double d2 = box.squaredExteriorDistance(c.centre);
+        if (d2 >= c.reach * c.reach) continue;
         if (is_leaf(c)) {
-            leaves.push_back(i);
+            if (d2 < c.radius * c.radius) leaves.push_back(i);
             continue;
         }
         for (int o = 0; o < 8; ++o) {

@@ -10,9 +10,11 @@ BlockGrid::BlockGrid(const PointSet &points, int resolution, const std::vector<f
     h = 1.0 / resolution;  // the longest side of the normalised box is 1
     double widest = min_reach;
     for (float r : reach) widest = std::max(widest, double(r));
-    // One spare block beyond the widest reach keeps the band off the grid's edge, so the
-    // region touching the edge surrounds everything.
-    const double pad = widest + B * h;
+    // Spare blocks beyond the widest reach keep the band off the grid's edge, so the region
+    // touching the edge surrounds everything. Two, not one: mark_band widens its boxes a hair,
+    // so with one a point at the box's edge marked block 0, the band reached the grid's edge
+    // and a surface crossing it was left open (fuzz_pipeline found it with garbage normals).
+    const double pad = widest + 2 * B * h;
     origin = points.box_min() - Eigen::Vector3d::Constant(pad);
     for (int d = 0; d < 3; ++d) {
         double extent = points.box_max()[d] - points.box_min()[d] + 2.0 * pad;

@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/progress.hpp"
 #include "geometry/point_set.hpp"
 #include "implicit/surface_field.hpp"
 #include "mesh/block_grid.hpp"
@@ -21,7 +22,9 @@ struct PointBuckets {
     std::vector<uint32_t> weight;   // points it stands for
 
     // `band`: the band's block ids, in the order polygonize processes them.
-    PointBuckets(const BlockGrid &g, const std::vector<int64_t> &band, const SurfaceField &f);
+    // Reports (at `fraction`) and checks for cancellation between its passes.
+    PointBuckets(const BlockGrid &g, const std::vector<int64_t> &band, const SurfaceField &f, Progress &progress,
+                 double fraction);
 
     size_t begin(size_t band_index) const { return offsets[band_index]; }
     size_t end(size_t band_index) const { return offsets[band_index + 1]; }

@@ -281,7 +281,7 @@ Mesh polygonize(const MpuFunction &mpu, const WindingField &winding, const Point
     progress.report(0.02);
     progress.throw_if_cancelled();
 
-    const PointBuckets buckets(g, band, f);
+    const PointBuckets buckets(g, band, f, progress, 0.02);
     progress.throw_if_cancelled();
     std::vector<BlockOutput> blocks(band.size());
     std::atomic<uint64_t> triangles{0};

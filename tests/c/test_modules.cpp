@@ -2,6 +2,7 @@
 // advance: quadric algebra, the three fits, the robust Taubin error, the noise estimate,
 // belief propagation, the marching-tetrahedra table (closed surfaces for any sign field),
 // the winding number, point-set validation, mesh clean-up and the parallel loop.
+#include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <map>
@@ -13,9 +14,11 @@
 #include "core/error.hpp"
 #include "core/parallel.hpp"
 #include "core/progress.hpp"
+#include "fit/build_octree.hpp"
 #include "fit/fits.hpp"
 #include "fit/noise_estimate.hpp"
 #include "geometry/point_set.hpp"
+#include "implicit/mpu_function.hpp"
 #include "mesh/marching_tetrahedra.hpp"
 #include "mesh/mesh_cleanup.hpp"
 #include "orient/belief_propagation.hpp"
@@ -190,6 +193,43 @@ void point_set_normalises_and_searches(void **) {
     assert_true(a == b);
 }
 
+// ---- the MPU blend ---------------------------------------------------------------------
+
+void blend_finds_every_covering_leaf(void **) {
+    // A sparse, noisy sphere: many cells grow their support past their parent's ball. The
+    // walk and the gathered lists must still find every leaf whose ball holds x (checked
+    // against all leaves), and both paths must give bit-identical values — the polygonizer's
+    // watertightness rests on it.
+    std::vector<double> xyz = flat(sphere_points(3000, 1.0, 0.02, 23));
+    PointSet ps = PointSet::from_array(xyz.data(), 3000, 0, 15);
+    Params params;
+    Progress progress(nullptr, nullptr, GMPU_STAGE_FIT);
+    Octree tree = build_octree(ps, params, 0.001, progress);
+    size_t grown = 0;
+    for (const Cell &c : tree.cells)
+        if (c.parent >= 0 && (c.centre - tree.cells[size_t(c.parent)].centre).norm() + c.radius >
+                                 tree.cells[size_t(c.parent)].radius)
+            ++grown;
+    assert_true(grown > 0);  // the case this test is about
+    MpuFunction f(tree, 0);
+    std::mt19937_64 rng(5);
+    std::uniform_real_distribution<double> u(-0.6, 0.6);
+    std::vector<uint32_t> near;
+    for (int q = 0; q < 2000; ++q) {
+        Vector3d x(u(rng), u(rng), u(rng));
+        std::vector<uint32_t> covering;
+        for (uint32_t i = 0; i < tree.cells.size(); ++i) {
+            const Cell &c = tree.cells[i];
+            if (c.is_leaf() && (x - c.centre).squaredNorm() < c.radius * c.radius) covering.push_back(i);
+        }
+        f.gather(Eigen::AlignedBox3d(x - Vector3d::Constant(0.01), x + Vector3d::Constant(0.01)), near);
+        for (uint32_t i : covering) assert_true(std::binary_search(near.begin(), near.end(), i));
+        Vector3d g1, g2;
+        const double a = f.value(x, &g1), b = f.value_among(near, x, &g2);
+        assert_true(a == b && g1 == g2);
+    }
+}
+
 // ---- belief propagation ---------------------------------------------------------------
 
 void bp_follows_clamped_evidence(void **) {
@@ -348,6 +388,7 @@ int main(void) {
         cmocka_unit_test(noise_estimate_tracks_the_noise),
         cmocka_unit_test(point_set_validation),
         cmocka_unit_test(point_set_normalises_and_searches),
+        cmocka_unit_test(blend_finds_every_covering_leaf),
         cmocka_unit_test(bp_follows_clamped_evidence),
         cmocka_unit_test(bp_data_term_breaks_ties_only),
         cmocka_unit_test(tetrahedra_cases_separate_signs),
