@@ -24,7 +24,9 @@
  *     (evaluate, copy_normals, get_param, get_stat, point_count, last_error) may run
  *     concurrently with each other; every other call on that handle needs exclusive
  *     access. Meshes and point sets never change after creation: all their accessors may
- *     run concurrently; only destroy needs exclusive access.
+ *     run concurrently; only destroy needs exclusive access. gmpu keeps no global mutable
+ *     state; gmpu_last_error() is per thread; a progress callback runs only on the thread
+ *     that called fit, orient or polygonize.
  *
  * Parameters and statistics go through gmpu_surface_set_param / gmpu_surface_get_stat with
  * an enum key (as zstd does), so new knobs never change a struct layout. Enum values are
@@ -131,7 +133,8 @@ typedef enum gmpu_param {
      * octree cells than this. Default 20,000,000 (about 4 GB). Range 1..1e9. */
     GMPU_PARAM_MAX_CELLS = 9,
     /* Resource cap: polygonize fails with GMPU_ERROR_LIMIT_EXCEEDED instead of making
-     * more triangles than this. Default 100,000,000. Range 1..2e9. */
+     * more triangles than this, counted as marching tetrahedra makes them (before closed
+     * pieces that no input point supports are dropped). Default 100,000,000. Range 1..2e9. */
     GMPU_PARAM_MAX_TRIANGLES = 10,
     /* Noise floor for ε: fit estimates the sampling noise σ̂ and works to
      * max(GMPU_PARAM_ERROR, NOISE_SCALE × σ̂), since fitting below the noise only fits the
@@ -210,7 +213,8 @@ GMPU_API gmpu_status gmpu_surface_set_progress(gmpu_surface *surface, gmpu_progr
  * (0 means tightly packed: 3 × sizeof(double) or 3 × sizeof(float)). Replaces earlier
  * points and discards any fit, orientation and input normals.
  * Errors: INVALID_ARGUMENT (NULL, stride smaller than one point), INVALID_INPUT (fewer
- * points than GMPU_PARAM_MIN_POINTS; a NaN or infinite coordinate, with its index),
+ * points than GMPU_PARAM_MIN_POINTS; a NaN or infinite coordinate, with its index; a
+ * coordinate beyond ±1e300 or a cloud spanning less than 1e-300: they cannot be normalised),
  * DEGENERATE_INPUT (all points identical, collinear or coplanar: they bound no volume),
  * OUT_OF_MEMORY. On failure the previous points are kept. Cost: O(n log n). */
 GMPU_API gmpu_status gmpu_surface_set_points_f64(gmpu_surface *surface, const double *xyz,

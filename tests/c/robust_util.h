@@ -128,7 +128,7 @@ static inline double *robust_torus(size_t n, double R, double r, const double c[
     return p;
 }
 
-static int robust_cmp_u64(const void *a, const void *b) {
+static inline int robust_cmp_u64(const void *a, const void *b) {
     uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
     return x < y ? -1 : x > y;
 }

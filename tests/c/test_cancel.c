@@ -17,8 +17,10 @@
  * and the smallest kept, so only a reproducible stall fails.
  *
  * GMPU_CANCEL_POINTS overrides the cloud size; GMPU_CANCEL_VERBOSE=1 prints every
- * measurement. Under ASan/UBSan/TSan (everything is 2-10x slower) the cloud is smaller and
- * the limits are scaled; under GMPU_TEST_QUICK (valgrind) only the semantics are checked. */
+ * measurement. The timing promises are for optimised builds: under ASan/UBSan/TSan (with
+ * the fuzzer's coverage instrumentation, Eigen code runs ~20x slower) and under
+ * GMPU_TEST_QUICK (valgrind) the cloud is small and only the semantics are checked, with a
+ * 2 s bound on the latency that still catches a cancel that is ignored. */
 #define _GNU_SOURCE
 #include <setjmp.h>
 #include <stdarg.h>
@@ -40,7 +42,7 @@ static double *g_points;
 static double g_latency_limit; /* seconds: 0.1 in an optimised build */
 static double g_gap_limit;     /* seconds: 0.05 promised; see setup */
 static int g_verbose;
-static int g_timing; /* 0 under GMPU_TEST_QUICK: semantics only */
+static int g_timing; /* 0 under valgrind or sanitizers: semantics only */
 
 static const char *stage_name(gmpu_stage s) {
     return s == GMPU_STAGE_FIT ? "fit" : s == GMPU_STAGE_ORIENT ? "orient" : "polygonize";
@@ -49,13 +51,12 @@ static const char *stage_name(gmpu_stage s) {
 static int setup(void **state) {
     (void)state;
     const char *env = getenv("GMPU_CANCEL_POINTS");
-    g_timing = !robust_quick();
-    g_n = env ? (size_t)atol(env) : !g_timing ? 3000 : ROBUST_INSTRUMENTED ? 120000 : 400000;
+    g_timing = !robust_quick() && !ROBUST_INSTRUMENTED;
+    g_n = env ? (size_t)atol(env) : robust_quick() ? 3000 : ROBUST_INSTRUMENTED ? 15000 : 400000;
     g_verbose = getenv("GMPU_CANCEL_VERBOSE") != NULL;
-    /* The header promises 100 ms and 50 ms of work; instrumented code does the same work
-     * 2-4x slower, so the same code paths take longer between checks. */
-    g_latency_limit = ROBUST_INSTRUMENTED ? 0.3 : 0.1;
-    g_gap_limit = ROBUST_INSTRUMENTED ? 0.2 : 0.05;
+    /* The header's promises: back within 100 ms of a cancel, a callback every 50 ms of work. */
+    g_latency_limit = g_timing ? 0.1 : 2.0;
+    g_gap_limit = 0.05;
     g_points = robust_bumpy_sphere(g_n, 11);
     return g_points ? 0 : -1;
 }
@@ -210,7 +211,7 @@ static void test_progress_cadence(void **state) {
  * points: on a machine fast enough to do a stage quicker, the cloud grows (once). */
 static void test_cloud_is_big_enough(void **state) {
     (void)state;
-    if (!g_timing || ROBUST_INSTRUMENTED || getenv("GMPU_CANCEL_POINTS")) skip();
+    if (!g_timing || getenv("GMPU_CANCEL_POINTS")) skip();
     double shortest = fmin(g_duration[GMPU_STAGE_FIT], fmin(g_duration[GMPU_STAGE_ORIENT], g_duration[GMPU_STAGE_POLYGONIZE]));
     if (shortest >= 0.5) return;
     size_t n = (size_t)((double)g_n * fmin(4.0, 0.65 / shortest));
@@ -287,15 +288,23 @@ static double cancel_once(gmpu_surface *s, watch *w, gmpu_stage stage, double de
  * leaves it ready for the next attempt), then finishes the pipeline on it. */
 static void cancel_stage(gmpu_stage stage) {
     if (g_duration[stage] == 0) fail_msg("test_progress_cadence must run first");
-    const int points = g_timing ? 10 : 3;
+    const int points = g_timing ? 10 : 4;
     watch w;
     watch_begin(&w, stage, -1);
     gmpu_surface *s = surface_at(stage, &w);
+    /* The stage's duration now, warm (a first run also pays for page faults): the delays
+     * are spread over it. */
+    gmpu_mesh *m = NULL;
+    watch_begin(&w, stage, -1);
+    double t0 = robust_now();
+    assert_ok(run_stage(s, stage, &m, &w));
+    const double duration = robust_now() - t0;
+    gmpu_mesh_destroy(m);
     double worst = 0, worst_delay = 0;
     int measured = 0;
     for (int k = 0; k < points; ++k) {
         /* Spread over the stage, from the very first callback (delay 0) to its end. */
-        const double delay = k == 0 ? 0.0 : g_duration[stage] * (k - 0.5) / (points - 1);
+        const double delay = k == 0 ? 0.0 : duration * (k - 0.5) / (points - 1);
         double best = INFINITY;
         for (int attempt = 0; attempt < 4; ++attempt) {
             double latency = cancel_once(s, &w, stage, delay);
@@ -304,7 +313,7 @@ static void cancel_stage(gmpu_stage stage) {
             if (g_verbose)
                 fprintf(stderr, "# %s cancelled after %.3f s: returned %.1f ms later\n", stage_name(stage),
                         w.cancelled_at - w.start, 1e3 * latency);
-            if (!g_timing || best <= g_latency_limit) break;
+            if (best <= g_latency_limit) break;
         }
         if (!isfinite(best)) continue;
         ++measured;
@@ -312,9 +321,9 @@ static void cancel_stage(gmpu_stage stage) {
     }
     fprintf(stderr, "# %s: %d cancellations over %.3f s, slowest returned %.1f ms after the request "
                     "(cancelled after %.3f s; limit %.0f ms)\n",
-            stage_name(stage), measured, g_duration[stage], 1e3 * worst, worst_delay, 1e3 * g_latency_limit);
+            stage_name(stage), measured, duration, 1e3 * worst, worst_delay, 1e3 * g_latency_limit);
     assert_true(measured >= points - 2); /* most delays fall inside the stage */
-    if (g_timing && worst > g_latency_limit)
+    if (worst > g_latency_limit)
         fail_msg("%s cancelled after %.3f s took %.1f ms to return (limit %.0f ms)", stage_name(stage), worst_delay,
                  1e3 * worst, 1e3 * g_latency_limit);
     finish_pipeline(s, stage, &w);

@@ -1,5 +1,6 @@
 /* The thread-safety contract of gmpu.h: on one oriented surface the const functions
- * (evaluate, copy_normals, get_param, get_stat, point_count) may run concurrently; separate
+ * (evaluate, copy_normals, get_param, get_stat, point_count) may run concurrently, and so
+ * may every accessor (and the writers) of one mesh or point set; separate
  * handles share no mutable state, so whole pipelines on separate surfaces in separate
  * threads give exactly (bit for bit) what they give one at a time; gmpu_last_error() is per
  * thread. Run under ThreadSanitizer by `make test-tsan`, which also sees the library's own
@@ -12,12 +13,14 @@
 #include <cmocka.h>
 
 #include <math.h>
+#include <libgen.h>
 #include <pthread.h>
 #include <sched.h>
 #include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "gmpu/gmpu.h"
 #include "robust_util.h"
@@ -34,8 +37,8 @@ static int setup(void **state) {
     (void)state;
     /* TSan runs 5-15x slower: keep the work small there. */
     const int small = robust_quick() || ROBUST_INSTRUMENTED;
-    g_n = small ? 4000 : 20000;
-    g_q = small ? 3000 : 20000;
+    g_n = robust_quick() ? 2000 : small ? 4000 : 20000;
+    g_q = robust_quick() ? 1000 : small ? 3000 : 20000;
     g_points = robust_torus(g_n, 1.0, 0.35, kTorusCentre, 21);
     g_queries = malloc(3 * g_q * sizeof *g_queries);
     if (!g_points || !g_queries) return -1;
@@ -70,12 +73,31 @@ static gmpu_surface *oriented(const double *xyz, size_t n, unsigned threads) {
 
 typedef struct {
     const gmpu_surface *s;
+    const gmpu_mesh *mesh;     /* meshes and point sets: any accessor from any thread */
+    const gmpu_points *points;
     int id;
     const double *ref_values, *ref_gradients, *ref_normals;
     atomic_int *go;
     int mismatches, failures;
     char failure[256];
 } eval_job;
+
+static char g_scratch[4096]; /* beside the executable: files the threads write */
+
+/* Sum of the bytes of a mesh's arrays and a point set's: the same from every thread. */
+static uint64_t fingerprint(const gmpu_mesh *m, const gmpu_points *p) {
+    uint64_t h = 1469598103934665603ull;
+    const unsigned char *b = (const unsigned char *)gmpu_mesh_vertices(m);
+    for (size_t i = 0; i < 3 * gmpu_mesh_vertex_count(m) * sizeof(double); ++i) h = (h ^ b[i]) * 1099511628211ull;
+    b = (const unsigned char *)gmpu_mesh_triangles(m);
+    for (size_t i = 0; i < 3 * gmpu_mesh_triangle_count(m) * sizeof(uint32_t); ++i) h = (h ^ b[i]) * 1099511628211ull;
+    b = (const unsigned char *)gmpu_mesh_normals(m);
+    for (size_t i = 0; b && i < 3 * gmpu_mesh_vertex_count(m) * sizeof(double); ++i) h = (h ^ b[i]) * 1099511628211ull;
+    b = (const unsigned char *)gmpu_points_positions(p);
+    for (size_t i = 0; i < 3 * gmpu_points_count(p) * sizeof(double); ++i) h = (h ^ b[i]) * 1099511628211ull;
+    return h;
+}
+static uint64_t g_fingerprint;
 
 static void *eval_worker(void *arg) {
     eval_job *j = arg;
@@ -107,6 +129,15 @@ static void *eval_worker(void *arg) {
         if (gmpu_surface_get_stat(j->s, GMPU_STAT_LEAVES, &x) != GMPU_OK || !(x > 0)) ++j->failures;
         if (gmpu_surface_get_param(j->s, GMPU_PARAM_RESOLUTION, &x) != GMPU_OK || x != 32) ++j->failures;
         if (gmpu_surface_point_count(j->s) != g_n) ++j->failures;
+        /* One mesh and one point set read by every thread at once, and written to files. */
+        if (fingerprint(j->mesh, j->points) != g_fingerprint) ++j->mismatches;
+        if (g_scratch[0]) {
+            char path[4200];
+            snprintf(path, sizeof path, "%s/concurrency-%d-%d.ply", g_scratch, j->id, round);
+            if (gmpu_mesh_write(j->mesh, path) != GMPU_OK || remove(path) != 0) ++j->failures;
+            snprintf(path, sizeof path, "%s/concurrency-%d-%d.xyz", g_scratch, j->id, round);
+            if (gmpu_points_write(j->points, path) != GMPU_OK || remove(path) != 0) ++j->failures;
+        }
     }
     free(v);
     free(g);
@@ -133,11 +164,24 @@ static void test_concurrent_evaluate_one_surface(void **state) {
     assert_ok(gmpu_surface_evaluate(s, c, 1, &f, NULL));
     assert_true(f > 0.2);
 
+    gmpu_mesh *mesh = NULL;
+    gmpu_points *points = NULL;
+    assert_ok(gmpu_surface_polygonize(s, &mesh));
+    assert_ok(gmpu_points_create(g_points, ref_n, g_n, &points));
+    g_fingerprint = fingerprint(mesh, points);
+    char exe[4096];
+    ssize_t len = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    g_scratch[0] = '\0';
+    if (len > 0) {
+        exe[len] = '\0';
+        snprintf(g_scratch, sizeof g_scratch, "%s", dirname(exe));
+    }
+
     atomic_int go = 0;
     eval_job jobs[EVAL_THREADS];
     pthread_t tid[EVAL_THREADS];
     for (int t = 0; t < EVAL_THREADS; ++t) {
-        jobs[t] = (eval_job){s, t, ref_v, ref_g, ref_n, &go, 0, 0, ""};
+        jobs[t] = (eval_job){s, mesh, points, t, ref_v, ref_g, ref_n, &go, 0, 0, ""};
         assert_int_equal(pthread_create(&tid[t], NULL, eval_worker, &jobs[t]), 0);
     }
     atomic_store(&go, 1);
@@ -149,6 +193,8 @@ static void test_concurrent_evaluate_one_surface(void **state) {
     free(ref_v);
     free(ref_g);
     free(ref_n);
+    gmpu_mesh_destroy(mesh);
+    gmpu_points_destroy(points);
     gmpu_surface_destroy(s);
 }
 

@@ -333,6 +333,9 @@ static void test_nonfinite_and_garbage_values(void **state) {
     put_text(aply, "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
                    "end_header\n0 0 0\n1 2 three\n4 5 6\n");
     expect_failure(aply, "GMPU_ERROR_PARSE", "three");
+    /* Bytes that are not printable ASCII are escaped: the message stays one clean line. */
+    put_text(xyz, "0 0 0\n1 2 \x01\x85\xffz\n");
+    expect_failure(xyz, "GMPU_ERROR_PARSE", "'\\x01\\x85\\xffz'");
     put_text(aply, "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
                    "end_header\n0 0 0\n1 2 1e99999\n4 5 6\n");
     {
