@@ -161,6 +161,7 @@ int main(int argc, char **argv) {
     gmpu_points *cloud = NULL;
     gmpu_surface *surface = NULL;
     gmpu_mesh *mesh = NULL;
+    size_t mesh_vertices = 0, mesh_triangles = 0;
     int rc = 1;
 
     if (gmpu_points_read(o.input, &cloud) != GMPU_OK) { rc = fail("cannot read input"); goto done; }
@@ -194,13 +195,18 @@ int main(int argc, char **argv) {
     if (gmpu_surface_polygonize(surface, &mesh) != GMPU_OK) { rc = fail("polygonize failed"); goto done; }
     double t_write = now_seconds();
     if (gmpu_mesh_write(mesh, o.output) != GMPU_OK) { rc = fail("cannot write mesh"); goto done; }
+    /* Written: free it before the oriented points need their memory (peak matters at 1M). */
+    mesh_vertices = gmpu_mesh_vertex_count(mesh);
+    mesh_triangles = gmpu_mesh_triangle_count(mesh);
+    gmpu_mesh_destroy(mesh);
+    mesh = NULL;
     if (o.normals_out) {
         double *normals = malloc(3 * n * sizeof *normals);
         gmpu_points *oriented = NULL;
         int ok = normals && gmpu_surface_copy_normals(surface, normals, n) == GMPU_OK &&
-                 gmpu_points_create(gmpu_points_positions(cloud), normals, n, &oriented) == GMPU_OK &&
-                 gmpu_points_write(oriented, o.normals_out) == GMPU_OK;
+                 gmpu_points_create(gmpu_points_positions(cloud), normals, n, &oriented) == GMPU_OK;
         free(normals);
+        ok = ok && gmpu_points_write(oriented, o.normals_out) == GMPU_OK;
         gmpu_points_destroy(oriented);
         if (!ok) {
             remove(o.output); /* all or nothing: no mesh without the normals asked for */
@@ -230,8 +236,7 @@ int main(int argc, char **argv) {
                 "gmpu: time read %.3f s, fit %.3f s, orient %.3f s, polygonize %.3f s, write %.3f s, "
                 "total %.3f s\n",
                 n, cells, leaves, depth, comps, comps == 1 ? "" : "s", 100 * noise, 100 * eps,
-                gmpu_mesh_vertex_count(mesh),
-                gmpu_mesh_triangle_count(mesh), res, o.output, t_read - t_start, fit, orient, poly,
+                mesh_vertices, mesh_triangles, res, o.output, t_read - t_start, fit, orient, poly,
                 t_end - t_write, t_end - t_start);
     }
     rc = 0;

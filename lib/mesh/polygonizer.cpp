@@ -17,9 +17,9 @@ namespace {
 
 constexpr int B = BlockGrid::B;
 // A closed piece of surface must be the nearest surface of at least this many input points
-// to be kept: a real part, however small, holds points (local fits need N_min of them);
-// a bubble of the far field or a stray quadric sheet holds none.
-constexpr uint32_t kMinVotes = 3;
+// to be kept: a real part holds at least the N_min (15) points one local fit needs; a
+// bubble of the far field or a stray quadric sheet holds none or a few noisy ones.
+constexpr uint32_t kMinVotes = 15;
 
 struct BlockOutput {
     std::vector<uint64_t> vertex_key;         // grid edge per vertex: corner id × 8 + direction

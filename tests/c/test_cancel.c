@@ -295,11 +295,17 @@ static void cancel_stage(gmpu_stage stage) {
     /* The stage's duration now, warm (a first run also pays for page faults): the delays
      * are spread over it. */
     gmpu_mesh *m = NULL;
-    watch_begin(&w, stage, -1);
-    double t0 = robust_now();
-    assert_ok(run_stage(s, stage, &m, &w));
-    const double duration = robust_now() - t0;
-    gmpu_mesh_destroy(m);
+    double duration = INFINITY;
+    /* The shorter of two runs: a delay near the end must still fall inside the stage when
+     * the machine gets quieter meanwhile. */
+    for (int run = 0; run < 2; ++run) {
+        watch_begin(&w, stage, -1);
+        double t0 = robust_now();
+        assert_ok(run_stage(s, stage, &m, &w));
+        duration = fmin(duration, robust_now() - t0);
+        gmpu_mesh_destroy(m);
+        m = NULL;
+    }
     double worst = 0, worst_delay = 0;
     int measured = 0;
     for (int k = 0; k < points; ++k) {
