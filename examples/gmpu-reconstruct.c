@@ -162,7 +162,8 @@ int main(int argc, char **argv) {
     gmpu_surface *surface = NULL;
     gmpu_mesh *mesh = NULL;
     size_t mesh_vertices = 0, mesh_triangles = 0;
-    int rc = 1;
+    double stat[10] = {0};
+    int stat_count = 0, rc = 1;
 
     if (gmpu_points_read(o.input, &cloud) != GMPU_OK) { rc = fail("cannot read input"); goto done; }
     double t_read = now_seconds();
@@ -200,11 +201,21 @@ int main(int argc, char **argv) {
     mesh_triangles = gmpu_mesh_triangle_count(mesh);
     gmpu_mesh_destroy(mesh);
     mesh = NULL;
+    /* The summary's figures, read now: writing the oriented points frees the surface. */
+    const gmpu_stat keys[] = {GMPU_STAT_CELLS, GMPU_STAT_LEAVES, GMPU_STAT_DEPTH, GMPU_STAT_COMPONENTS,
+                              GMPU_STAT_NOISE, GMPU_STAT_EFFECTIVE_ERROR, GMPU_STAT_FIT_SECONDS,
+                              GMPU_STAT_ORIENT_SECONDS, GMPU_STAT_POLYGONIZE_SECONDS, GMPU_STAT_RESOLUTION};
+    stat_count = (int)(sizeof keys / sizeof keys[0]);
+    for (int k = 0; k < stat_count; ++k) gmpu_surface_get_stat(surface, keys[k], &stat[k]);
     if (o.normals_out) {
         double *normals = malloc(3 * n * sizeof *normals);
         gmpu_points *oriented = NULL;
-        int ok = normals && gmpu_surface_copy_normals(surface, normals, n) == GMPU_OK &&
-                 gmpu_points_create(gmpu_points_positions(cloud), normals, n, &oriented) == GMPU_OK;
+        int ok = normals && gmpu_surface_copy_normals(surface, normals, n) == GMPU_OK;
+        /* Its normals copied, the surface is done: free it before the copy below (at a
+         * million points, the two together would set the peak). */
+        gmpu_surface_destroy(surface);
+        surface = NULL;
+        ok = ok && gmpu_points_create(gmpu_points_positions(cloud), normals, n, &oriented) == GMPU_OK;
         free(normals);
         ok = ok && gmpu_points_write(oriented, o.normals_out) == GMPU_OK;
         gmpu_points_destroy(oriented);
@@ -217,18 +228,8 @@ int main(int argc, char **argv) {
     double t_end = now_seconds();
 
     if (!o.quiet) {
-        double cells = 0, leaves = 0, depth = 0, comps = 0, fit = 0, orient = 0, poly = 0, res = 0;
-        double noise = 0, eps = 0;
-        gmpu_surface_get_stat(surface, GMPU_STAT_NOISE, &noise);
-        gmpu_surface_get_stat(surface, GMPU_STAT_EFFECTIVE_ERROR, &eps);
-        gmpu_surface_get_stat(surface, GMPU_STAT_CELLS, &cells);
-        gmpu_surface_get_stat(surface, GMPU_STAT_LEAVES, &leaves);
-        gmpu_surface_get_stat(surface, GMPU_STAT_DEPTH, &depth);
-        gmpu_surface_get_stat(surface, GMPU_STAT_COMPONENTS, &comps);
-        gmpu_surface_get_stat(surface, GMPU_STAT_FIT_SECONDS, &fit);
-        gmpu_surface_get_stat(surface, GMPU_STAT_ORIENT_SECONDS, &orient);
-        gmpu_surface_get_stat(surface, GMPU_STAT_POLYGONIZE_SECONDS, &poly);
-        gmpu_surface_get_stat(surface, GMPU_STAT_RESOLUTION, &res);
+        const double cells = stat[0], leaves = stat[1], depth = stat[2], comps = stat[3], noise = stat[4],
+                     eps = stat[5], fit = stat[6], orient = stat[7], poly = stat[8], res = stat[9];
         fprintf(stderr,
                 "gmpu: %zu points, %.0f cells (%.0f leaves, depth %.0f) in %.0f connected group%s\n"
                 "gmpu: estimated noise %.3f%% of the diagonal, fitted to error %.3f%%\n"

@@ -11,11 +11,7 @@ constexpr double kInv4Pi = 0.25 / M_PI;
 
 WindingField::WindingField(const Octree &tree, const PointSet &points, const std::vector<float> &normals,
                            const std::vector<float> &area, Progress *progress)
-    : tree_(&tree), points_(&points), moments_(tree.cells.size()), weighted_(points.size()) {
-    for (size_t k = 0; k < tree.order.size(); ++k) {
-        uint32_t i = tree.order[k];
-        weighted_[k] = area[i] * Eigen::Vector3f(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);
-    }
+    : tree_(&tree), points_(&points), moments_(tree.cells.size()), normals_(&normals), area_(&area) {
     // Children follow parents, so a reverse sweep could aggregate; a direct pass over each
     // cell's contiguous point range is as simple and costs O(n · depth).
     for (size_t c = 0; c < tree.cells.size(); ++c) {
@@ -26,7 +22,7 @@ WindingField::WindingField(const Octree &tree, const PointSet &points, const std
         for (uint32_t k = cell.point_begin; k < cell.point_end; ++k) {
             double a = double(area[tree.order[k]]);
             m.centroid += a * points.point(tree.order[k]);
-            m.dipole += weighted_[k].cast<double>();
+            m.dipole += weighted(tree.order[k]);
             total += a;
         }
         if (total <= 0.0) continue;
@@ -49,7 +45,7 @@ double WindingField::visit(uint32_t index, const Eigen::Vector3d &q) const {
         for (uint32_t k = c.point_begin; k < c.point_end; ++k) {
             Eigen::Vector3d rp = points_->point(tree_->order[k]) - q;
             double e2 = rp.squaredNorm();
-            if (e2 > 1e-24) w += kInv4Pi * weighted_[k].cast<double>().dot(rp) / (e2 * std::sqrt(e2));
+            if (e2 > 1e-24) w += kInv4Pi * weighted(tree_->order[k]).dot(rp) / (e2 * std::sqrt(e2));
         }
         return w;
     }

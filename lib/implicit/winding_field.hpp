@@ -18,7 +18,8 @@ namespace gmpu {
 class WindingField {
 public:
     WindingField() = default;
-    // normals: unit outward, 3 per point; area: surface area each point stands for.
+    // normals: unit outward, 3 per point; area: surface area each point stands for. Both are
+    // read again by winding(), so they must outlive the field (the surface owns all three).
     // O(n · depth): with a progress, reports between 0.95 and 1 and throws CANCELLED.
     WindingField(const Octree &tree, const PointSet &points, const std::vector<float> &normals,
                  const std::vector<float> &area, Progress *progress = nullptr);
@@ -35,8 +36,12 @@ private:
     double visit(uint32_t cell, const Eigen::Vector3d &q) const;
     const Octree *tree_ = nullptr;
     const PointSet *points_ = nullptr;
-    std::vector<Moment> moments_;           // per cell
-    std::vector<Eigen::Vector3f> weighted_;  // per point (in octree order): A n
+    std::vector<Moment> moments_;  // per cell
+    const std::vector<float> *normals_ = nullptr, *area_ = nullptr;
+    Eigen::Vector3d weighted(uint32_t i) const {  // A n of point i
+        const std::vector<float> &n = *normals_;
+        return double((*area_)[i]) * Eigen::Vector3d(n[3 * i], n[3 * i + 1], n[3 * i + 2]);
+    }
 };
 
 }  // namespace gmpu
