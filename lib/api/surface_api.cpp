@@ -13,6 +13,7 @@
 #include "core/parallel.hpp"
 #include "core/params.hpp"
 #include "core/progress.hpp"
+#include "core/release_memory.hpp"
 #include "fit/build_octree.hpp"
 #include "fit/noise_estimate.hpp"
 #include "geometry/point_set.hpp"
@@ -219,7 +220,11 @@ GMPU_API gmpu_status gmpu_surface_create(gmpu_surface **out) {
     });
 }
 
-GMPU_API void gmpu_surface_destroy(gmpu_surface *s) { delete s; }
+GMPU_API void gmpu_surface_destroy(gmpu_surface *s) {
+    if (!s) return;
+    delete s;
+    gmpu::release_free_memory();
+}
 
 GMPU_API const char *gmpu_surface_last_error(const gmpu_surface *s) { return s ? s->last_error.c_str() : ""; }
 
@@ -317,7 +322,7 @@ GMPU_API gmpu_status gmpu_surface_set_normals_f32(gmpu_surface *s, const float *
 GMPU_API size_t gmpu_surface_point_count(const gmpu_surface *s) { return s ? s->points.size() : 0; }
 
 GMPU_API gmpu_status gmpu_surface_fit(gmpu_surface *s) {
-    return guarded(s ? &s->last_error : nullptr, [&] {
+    const gmpu_status status = guarded(s ? &s->last_error : nullptr, [&] {
         require_arg(s, "surface");
         s->require(gmpu_surface::Stage::points, "gmpu_surface_fit", "gmpu_surface_set_points");
         auto t0 = Clock::now();
@@ -334,10 +339,12 @@ GMPU_API gmpu_status gmpu_surface_fit(gmpu_surface *s) {
         s->stage = gmpu_surface::Stage::fitted;
         s->seconds[GMPU_STAGE_FIT] = since(t0);
     });
+    gmpu::release_free_memory();  // the stage's temporaries, freed by now
+    return status;
 }
 
 GMPU_API gmpu_status gmpu_surface_orient(gmpu_surface *s) {
-    return guarded(s ? &s->last_error : nullptr, [&] {
+    const gmpu_status status = guarded(s ? &s->last_error : nullptr, [&] {
         require_arg(s, "surface");
         s->require(gmpu_surface::Stage::fitted, "gmpu_surface_orient", "gmpu_surface_fit");
         auto t0 = Clock::now();
@@ -365,6 +372,8 @@ GMPU_API gmpu_status gmpu_surface_orient(gmpu_surface *s) {
         s->stage = gmpu_surface::Stage::oriented;
         s->seconds[GMPU_STAGE_ORIENT] = since(t0);
     });
+    gmpu::release_free_memory();  // the stage's temporaries, freed by now
+    return status;
 }
 
 GMPU_API gmpu_status gmpu_surface_evaluate(const gmpu_surface *s, const double *xyz, size_t count, double *values,
@@ -407,7 +416,7 @@ GMPU_API gmpu_status gmpu_surface_copy_normals(const gmpu_surface *s, double *ou
 }
 
 GMPU_API gmpu_status gmpu_surface_polygonize(gmpu_surface *s, gmpu_mesh **out) {
-    return guarded(s ? &s->last_error : nullptr, [&] {
+    const gmpu_status status = guarded(s ? &s->last_error : nullptr, [&] {
         require_arg(s, "surface");
         require_arg(out, "out");
         *out = nullptr;
@@ -424,6 +433,8 @@ GMPU_API gmpu_status gmpu_surface_polygonize(gmpu_surface *s, gmpu_mesh **out) {
         s->seconds[GMPU_STAGE_POLYGONIZE] = since(t0);
         *out = mesh.release();
     });
+    gmpu::release_free_memory();  // the stage's temporaries, freed by now
+    return status;
 }
 
 }  // extern "C"

@@ -177,11 +177,53 @@ static void test_max_depth(void **state) {
     gmpu_surface_destroy(s);
 }
 
+/* Resident memory in bytes (Linux /proc/self/statm), 0 if unknown. */
+static size_t resident_bytes(void) {
+    FILE *f = fopen("/proc/self/statm", "r");
+    unsigned long pages_total = 0, pages_resident = 0;
+    if (!f) return 0;
+    int got = fscanf(f, "%lu %lu", &pages_total, &pages_resident);
+    fclose(f);
+    return got == 2 ? (size_t)pages_resident * 4096u : 0;
+}
+
+/* The stages free their temporaries and destroy frees the surface: the process's resident
+ * size must fall back, not stay at the stage's high-water mark (glibc keeps freed heap
+ * unless asked; at a million points that was 60 MB under the host's next allocation). */
+static void test_memory_returned(void **state) {
+    (void)state;
+    /* Sanitizers and valgrind (GMPU_TEST_QUICK) bring heaps of their own. */
+    if (ROBUST_INSTRUMENTED || robust_quick() || resident_bytes() == 0) skip();
+    const size_t n = 200000;
+    const double centre[3] = {0, 0, 0};
+    double *xyz = robust_sphere(n, centre, 1.0, 9);
+    assert_non_null(xyz);
+    const size_t before = resident_bytes();
+    gmpu_surface *s = NULL;
+    assert_ok(gmpu_surface_create(&s));
+    assert_ok(gmpu_surface_set_points_f64(s, xyz, n, 0));
+    assert_ok(gmpu_surface_fit(s));
+    assert_ok(gmpu_surface_orient(s));
+    gmpu_mesh *m = NULL;
+    assert_ok(gmpu_surface_polygonize(s, &m));
+    const size_t alive = resident_bytes();
+    gmpu_mesh_destroy(m);
+    gmpu_surface_destroy(s);
+    const size_t after = resident_bytes();
+    free(xyz);
+    print_message("resident: %.1f MB before, %.1f MB with the surface, %.1f MB after destroy\n",
+                  before / 1e6, alive / 1e6, after / 1e6);
+    assert_true(alive > before);
+    if (after > before + (alive - before) / 4)
+        fail_msg("%.1f of %.1f MB still resident after destroy", (after - before) / 1e6, (alive - before) / 1e6);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_max_cells),
         cmocka_unit_test(test_max_triangles),
         cmocka_unit_test(test_max_depth),
+        cmocka_unit_test(test_memory_returned),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
