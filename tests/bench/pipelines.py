@@ -135,7 +135,23 @@ class Gmpu(Pipeline):
             return {}  # an older CLI without stage times: only wall time is known
         return {name: float(sec) for name, sec in re.findall(r"(\w+) ([\d.]+) s", found[-1])}
 
+    # gmpu takes a fraction of a second on most clouds, where one run on a shared machine
+    # varies by ±30 %: the median of REPEATS runs is reported (the peers take seconds and
+    # run once; repeating them would double the benchmark's length).
+    REPEATS = 3
+    REPEAT_BELOW_SECONDS = 10.0
+
     def run(self, cloud, workdir, timeout):
+        runs = [self.run_once(cloud, workdir, timeout)]
+        while (len(runs) < self.REPEATS and runs[-1].ok and runs[-1].compute < self.REPEAT_BELOW_SECONDS):
+            runs.append(self.run_once(cloud, workdir, timeout))
+        if not all(r.ok for r in runs):
+            return next(r for r in runs if not r.ok)
+        median = sorted(runs, key=lambda r: r.compute)[len(runs) // 2]
+        median.info["repeats"] = len(runs)  # every run wrote the same mesh: the last one is on disk
+        return median
+
+    def run_once(self, cloud, workdir, timeout):
         run = super().run(cloud, workdir, timeout)
         if run.ok and not run.stages:
             run.compute = run.wall
