@@ -7,8 +7,6 @@
 #include <stdint.h>
 #include <cmocka.h>
 
-#include <dirent.h>
-#include <ftw.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -16,42 +14,16 @@
 #include <sys/stat.h>
 
 #include "gmpu/gmpu.h"
-
-static char g_dir[64];
-
-static const char *path_of(const char *name) {
-    static char buf[4][256]; /* a few paths may be alive at once */
-    static int next = 0;
-    char *p = buf[next++ % 4];
-    snprintf(p, 256, "%s/%s", g_dir, name);
-    return p;
-}
-
-static int remove_entry(const char *p, const struct stat *st, int flag, struct FTW *ftw) {
-    (void)st, (void)flag, (void)ftw;
-    return remove(p);
-}
+#include "scratch_dir.h"
 
 static int setup(void **state) {
     (void)state;
-    strcpy(g_dir, "/tmp/gmpu_test_io_abi_XXXXXX");
-    return mkdtemp(g_dir) ? 0 : -1;
+    return scratch_create("io-abi-scratch");
 }
 
 static int teardown(void **state) {
     (void)state;
-    return nftw(g_dir, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
-}
-
-static int count_entries(const char *dir) {
-    int n = 0;
-    DIR *d = opendir(dir);
-    struct dirent *e;
-    if (!d) return -1;
-    while ((e = readdir(d)) != NULL)
-        if (strcmp(e->d_name, ".") != 0 && strcmp(e->d_name, "..") != 0) ++n;
-    closedir(d);
-    return n;
+    return scratch_remove();
 }
 
 static void put(const char *path, const char *text) {
@@ -122,7 +94,7 @@ static void test_points_file_round_trip(void **state) {
         for (int with_normals = 0; with_normals < 2; ++with_normals) {
             gmpu_points *p = NULL, *q = NULL;
             assert_int_equal(gmpu_points_create(tet, with_normals ? n : NULL, 4, &p), GMPU_OK);
-            const char *path = path_of(names[i]);
+            const char *path = scratch_path(names[i]);
             assert_int_equal(gmpu_points_write(p, path), GMPU_OK);
             assert_int_equal(gmpu_points_read(path, &q), GMPU_OK);
             assert_int_equal(gmpu_points_count(q), 4);
@@ -142,17 +114,17 @@ static void test_points_read_errors(void **state) {
     gmpu_points *p = (gmpu_points *)&p;
     check_failure(gmpu_points_read(NULL, &p), GMPU_ERROR_INVALID_ARGUMENT, "path is NULL");
     assert_null(p);
-    check_failure(gmpu_points_read(path_of("x.ply"), NULL), GMPU_ERROR_INVALID_ARGUMENT, "out is NULL");
+    check_failure(gmpu_points_read(scratch_path("x.ply"), NULL), GMPU_ERROR_INVALID_ARGUMENT, "out is NULL");
 
-    const char *missing = path_of("missing.ply");
+    const char *missing = scratch_path("missing.ply");
     p = (gmpu_points *)&p;
     check_failure(gmpu_points_read(missing, &p), GMPU_ERROR_IO, missing);
     assert_null(p);
     check_failure(gmpu_points_read(missing, &p), GMPU_ERROR_IO, "No such file or directory");
-    check_failure(gmpu_points_read(g_dir, &p), GMPU_ERROR_UNSUPPORTED, "no file extension");
-    check_failure(gmpu_points_read(path_of("a.stl"), &p), GMPU_ERROR_UNSUPPORTED, "'.stl'");
+    check_failure(gmpu_points_read(scratch_dir, &p), GMPU_ERROR_UNSUPPORTED, "no file extension");
+    check_failure(gmpu_points_read(scratch_path("a.stl"), &p), GMPU_ERROR_UNSUPPORTED, "'.stl'");
 
-    const char *bad = path_of("bad.xyz");
+    const char *bad = scratch_path("bad.xyz");
     put(bad, "1 2 3\n4 5 six\n");
     check_failure(gmpu_points_read(bad, &p), GMPU_ERROR_PARSE, "line 2: invalid number 'six'");
     assert_null(p);
@@ -160,7 +132,7 @@ static void test_points_read_errors(void **state) {
     check_failure(gmpu_points_read(bad, &p), GMPU_ERROR_INVALID_INPUT, "vertex 1");
     put(bad, "# nothing\n");
     check_failure(gmpu_points_read(bad, &p), GMPU_ERROR_INVALID_INPUT, "no points");
-    const char *ply = path_of("bad.ply");
+    const char *ply = scratch_path("bad.ply");
     put(ply, "ply\nformat ascii 1.0\nelement vertex 9\nproperty float x\nproperty float y\n"
              "property float z\nend_header\n1 2 3\n");
     check_failure(gmpu_points_read(ply, &p), GMPU_ERROR_PARSE, "expected 9 vertices, file ends after 1");
@@ -173,14 +145,14 @@ static void test_points_write_errors(void **state) {
     (void)state;
     gmpu_points *p = NULL;
     assert_int_equal(gmpu_points_create(tet, NULL, 4, &p), GMPU_OK);
-    check_failure(gmpu_points_write(NULL, path_of("a.ply")), GMPU_ERROR_INVALID_ARGUMENT, "points is NULL");
+    check_failure(gmpu_points_write(NULL, scratch_path("a.ply")), GMPU_ERROR_INVALID_ARGUMENT, "points is NULL");
     check_failure(gmpu_points_write(p, NULL), GMPU_ERROR_INVALID_ARGUMENT, "path is NULL");
-    check_failure(gmpu_points_write(p, path_of("a.off")), GMPU_ERROR_UNSUPPORTED, "'.off'");
-    const char *deep = path_of("no/such/dir/a.ply");
+    check_failure(gmpu_points_write(p, scratch_path("a.off")), GMPU_ERROR_UNSUPPORTED, "'.off'");
+    const char *deep = scratch_path("no/such/dir/a.ply");
     check_failure(gmpu_points_write(p, deep), GMPU_ERROR_IO, deep);
     check_failure(gmpu_points_write(p, deep), GMPU_ERROR_IO, "No such file or directory");
     gmpu_points_destroy(p);
-    assert_int_equal(count_entries(g_dir), 0); /* nothing created, not even a temporary */
+    assert_int_equal(scratch_count(scratch_dir, ""), 0); /* nothing created, not even a temporary */
 }
 
 static void test_mesh_create_and_access(void **state) {
@@ -234,7 +206,7 @@ static void test_mesh_write(void **state) {
     const char *names[] = {"m.ply", "m.obj", "m.off", "M.OFF"};
     const char *magic[] = {"ply\nformat binary_little_endian 1.0\n", "# written by gmpu\nv ", "OFF\n4 4 0\n", "OFF\n"};
     for (int i = 0; i < 4; ++i) {
-        const char *path = path_of(names[i]);
+        const char *path = scratch_path(names[i]);
         assert_int_equal(gmpu_mesh_write(m, path), GMPU_OK);
         char head[64] = {0};
         FILE *f = fopen(path, "rb");
@@ -250,18 +222,18 @@ static void test_mesh_write(void **state) {
         gmpu_points_destroy(p);
     }
 
-    mkdir(path_of("w"), 0755);
-    check_failure(gmpu_mesh_write(NULL, path_of("w/a.ply")), GMPU_ERROR_INVALID_ARGUMENT, "mesh is NULL");
+    mkdir(scratch_path("w"), 0755);
+    check_failure(gmpu_mesh_write(NULL, scratch_path("w/a.ply")), GMPU_ERROR_INVALID_ARGUMENT, "mesh is NULL");
     check_failure(gmpu_mesh_write(m, NULL), GMPU_ERROR_INVALID_ARGUMENT, "path is NULL");
-    check_failure(gmpu_mesh_write(m, path_of("w/a.stl")), GMPU_ERROR_UNSUPPORTED, "'.stl'");
-    check_failure(gmpu_mesh_write(m, path_of("w/a.xyz")), GMPU_ERROR_UNSUPPORTED, "'.xyz'");
-    const char *deep = path_of("w/missing/a.obj");
+    check_failure(gmpu_mesh_write(m, scratch_path("w/a.stl")), GMPU_ERROR_UNSUPPORTED, "'.stl'");
+    check_failure(gmpu_mesh_write(m, scratch_path("w/a.xyz")), GMPU_ERROR_UNSUPPORTED, "'.xyz'");
+    const char *deep = scratch_path("w/missing/a.obj");
     check_failure(gmpu_mesh_write(m, deep), GMPU_ERROR_IO, deep);
     check_failure(gmpu_mesh_write(m, deep), GMPU_ERROR_IO, "No such file or directory");
-    mkdir(path_of("w/dir.ply"), 0755);
-    check_failure(gmpu_mesh_write(m, path_of("w/dir.ply")), GMPU_ERROR_IO, "Is a directory");
-    assert_int_equal(count_entries(path_of("w")), 1); /* only dir.ply: no temporaries */
-    assert_int_equal(count_entries(path_of("w/dir.ply")), 0);
+    mkdir(scratch_path("w/dir.ply"), 0755);
+    check_failure(gmpu_mesh_write(m, scratch_path("w/dir.ply")), GMPU_ERROR_IO, "Is a directory");
+    assert_int_equal(scratch_count(scratch_path("w"), ""), 1); /* only dir.ply: no temporaries */
+    assert_int_equal(scratch_count(scratch_path("w/dir.ply"), ""), 0);
     gmpu_mesh_destroy(m);
 }
 
@@ -297,7 +269,7 @@ int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_points_create_and_access),
         cmocka_unit_test(test_points_create_errors),
-        cmocka_unit_test(test_points_write_errors), /* first to touch g_dir: counts entries */
+        cmocka_unit_test(test_points_write_errors), /* first to touch scratch_dir: counts entries */
         cmocka_unit_test(test_points_file_round_trip),
         cmocka_unit_test(test_points_read_errors),
         cmocka_unit_test(test_mesh_create_and_access),

@@ -13,10 +13,7 @@
 #include <stdint.h>
 #include <cmocka.h>
 
-#include <dirent.h>
 #include <fcntl.h>
-#include <ftw.h>
-#include <libgen.h>
 #include <limits.h>
 #include <math.h>
 #include <spawn.h>
@@ -29,48 +26,28 @@
 
 #include "gmpu/gmpu.h"
 #include "../c/robust_util.h"
+#include "../c/scratch_dir.h"
 
 extern char **environ;
 
 static char g_cli[PATH_MAX];
-static char g_dir[PATH_MAX]; /* scratch directory, inside the build directory */
-
-static const char *path_of(const char *name) {
-    static char buf[16][PATH_MAX + 256]; /* a few paths are alive at once */
-    static int next = 0;
-    char *p = buf[next++ % 16];
-    snprintf(p, sizeof buf[0], "%s/%s", g_dir, name);
-    return p;
-}
-
-static int remove_entry(const char *p, const struct stat *st, int flag, struct FTW *ftw) {
-    (void)st, (void)flag, (void)ftw;
-    return remove(p);
-}
-
 static int setup(void **state) {
     (void)state;
-    char exe[PATH_MAX];
-    ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
-    if (n <= 0) return -1;
-    exe[n] = '\0';
-    char *dir = dirname(exe); /* <build>/tests/c */
     const char *override = getenv("GMPU_CLI");
     if (override)
         snprintf(g_cli, sizeof g_cli, "%s", override);
-    else
-        snprintf(g_cli, sizeof g_cli, "%s/../../examples/gmpu-reconstruct", dir);
+    else /* this test runs from <build>/tests/c */
+        snprintf(g_cli, sizeof g_cli, "%s/../../examples/gmpu-reconstruct", scratch_exe_dir());
     if (access(g_cli, X_OK) != 0) {
         fprintf(stderr, "gmpu-reconstruct not found at %s (set GMPU_CLI)\n", g_cli);
         return -1;
     }
-    snprintf(g_dir, sizeof g_dir, "%s/cli-scratch-XXXXXX", dir);
-    return mkdtemp(g_dir) ? 0 : -1;
+    return scratch_create("cli-scratch");
 }
 
 static int teardown(void **state) {
     (void)state;
-    return nftw(g_dir, remove_entry, 16, FTW_DEPTH | FTW_PHYS);
+    return scratch_remove();
 }
 
 /* ---- running the CLI ---- */
@@ -90,7 +67,7 @@ static run_result run_cli(const char *const *args) {
     for (; args[argc - 1] && argc < 31; ++argc) argv[argc] = args[argc - 1];
     argv[argc] = NULL;
     static char err_path[PATH_MAX + 32];
-    snprintf(err_path, sizeof err_path, "%s/stderr.txt", g_dir);
+    snprintf(err_path, sizeof err_path, "%s/stderr.txt", scratch_dir);
     posix_spawn_file_actions_t fa;
     posix_spawn_file_actions_init(&fa);
     posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
@@ -118,18 +95,6 @@ static run_result run_cli(const char *const *args) {
 static int exists(const char *path) {
     struct stat st;
     return stat(path, &st) == 0;
-}
-
-/* Entries of g_dir other than the inputs the test made: what the CLI left behind. */
-static int count_entries_starting(const char *prefix) {
-    int n = 0;
-    DIR *d = opendir(g_dir);
-    struct dirent *e;
-    if (!d) return -1;
-    while ((e = readdir(d)) != NULL)
-        if (strncmp(e->d_name, prefix, strlen(prefix)) == 0) ++n;
-    closedir(d);
-    return n;
 }
 
 #define check_run(r, want_status, needle)                                                                   \
@@ -245,36 +210,36 @@ static void check_off_sphere(const char *path, const double c[3], double radius,
 
 /* Every failing case below: one line, exit 1, the named problem, no output. */
 static void expect_failure(const char *input, const char *needle, const char *needle2) {
-    const char *out = path_of("out.ply");
+    const char *out = scratch_path("out.ply");
     remove(out);
     const char *args[] = {input, "-o", out, "--quiet", "--resolution", "24", NULL};
     run_result r = run_cli(args);
     check_run(&r, 1, needle);
     if (needle2 && !strstr(r.err, needle2)) fail_msg("stderr lacks \"%s\":\n%s", needle2, r.err);
     assert_false(exists(out));
-    assert_int_equal(count_entries_starting("out."), 0); /* no temporary either */
+    assert_int_equal(scratch_count(scratch_dir, "out."), 0); /* no temporary either */
 }
 
-static void test_missing_directory_and_unknown_inputs(void **state) {
+static void test_missinscratch_directory_and_unknown_inputs(void **state) {
     (void)state;
-    const char *missing = path_of("no-such-cloud.ply");
+    const char *missing = scratch_path("no-such-cloud.ply");
     expect_failure(missing, "no-such-cloud.ply", "No such file or directory");
     expect_failure(missing, "GMPU_ERROR_IO", NULL);
-    const char *dir = path_of("cloud-dir.ply");
+    const char *dir = scratch_path("cloud-dir.ply");
     assert_int_equal(mkdir(dir, 0755), 0);
     expect_failure(dir, "cloud-dir.ply", "Is a directory");
-    expect_failure(g_dir, "GMPU_ERROR_UNSUPPORTED", "no file extension");
-    const char *stl = path_of("cloud.stl");
+    expect_failure(scratch_dir, "GMPU_ERROR_UNSUPPORTED", "no file extension");
+    const char *stl = scratch_path("cloud.stl");
     put_text(stl, "solid x\nendsolid x\n");
     expect_failure(stl, "GMPU_ERROR_UNSUPPORTED", "'.stl'");
-    const char *empty = path_of("empty.xyz");
+    const char *empty = scratch_path("empty.xyz");
     put_text(empty, "");
     expect_failure(empty, "GMPU_ERROR_INVALID_INPUT", "no points");
-    const char *comments = path_of("comments.xyz");
+    const char *comments = scratch_path("comments.xyz");
     put_text(comments, "# only a comment\n\n");
     expect_failure(comments, "GMPU_ERROR_INVALID_INPUT", "no points");
     /* Unreadable (unless running as root, which reads anything). */
-    const char *locked = path_of("locked.xyz");
+    const char *locked = scratch_path("locked.xyz");
     put_xyz(locked, g_sphere, 100);
     chmod(locked, 0);
     if (geteuid() != 0) expect_failure(locked, "GMPU_ERROR_IO", "Permission denied");
@@ -283,7 +248,7 @@ static void test_missing_directory_and_unknown_inputs(void **state) {
 
 static void test_too_few_and_degenerate_clouds(void **state) {
     (void)state;
-    const char *in = path_of("few.xyz");
+    const char *in = scratch_path("few.xyz");
     for (size_t n = 1; n <= 3; ++n) {
         put_xyz(in, g_sphere, n);
         char needle[64];
@@ -306,7 +271,7 @@ static void test_too_few_and_degenerate_clouds(void **state) {
         double a = robust_uniform(&rng), b = robust_uniform(&rng);
         p[3 * i] = a, p[3 * i + 1] = b, p[3 * i + 2] = 2 * a - b + 4;
     }
-    const char *ply = path_of("plane.ply");
+    const char *ply = scratch_path("plane.ply");
     put_ply_le(ply, p, N, 0);
     expect_failure(ply, "GMPU_ERROR_DEGENERATE_INPUT", "coplanar");
     expect_failure(ply, "no closed surface", NULL);
@@ -318,10 +283,10 @@ static void test_nonfinite_and_garbage_values(void **state) {
     memcpy(p, g_sphere, 3 * N_SPHERE * sizeof *p);
     p[3 * 41 + 1] = NAN;
     p[3 * 900] = INFINITY;
-    const char *ply = path_of("nan.ply");
+    const char *ply = scratch_path("nan.ply");
     put_ply_le(ply, p, N_SPHERE, 0);
     expect_failure(ply, "GMPU_ERROR_INVALID_INPUT", "vertex 41 ");
-    const char *xyz = path_of("inf.xyz");
+    const char *xyz = scratch_path("inf.xyz");
     p[3 * 41 + 1] = 0;
     put_xyz(xyz, p, N_SPHERE); /* prints "inf" */
     expect_failure(xyz, "GMPU_ERROR_INVALID_INPUT", "vertex 900 ");
@@ -329,7 +294,7 @@ static void test_nonfinite_and_garbage_values(void **state) {
     /* Garbage in ascii numbers: the line is named. */
     put_text(xyz, "0 0 0\n1 0 0\n0 1 0\n0 0 1x\n");
     expect_failure(xyz, "GMPU_ERROR_PARSE", "line 4");
-    const char *aply = path_of("garbage.ply");
+    const char *aply = scratch_path("garbage.ply");
     put_text(aply, "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
                    "end_header\n0 0 0\n1 2 three\n4 5 6\n");
     expect_failure(aply, "GMPU_ERROR_PARSE", "three");
@@ -339,7 +304,7 @@ static void test_nonfinite_and_garbage_values(void **state) {
     put_text(aply, "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
                    "end_header\n0 0 0\n1 2 1e99999\n4 5 6\n");
     {
-        const char *out = path_of("out.ply");
+        const char *out = scratch_path("out.ply");
         const char *args[] = {aply, "-o", out, "--quiet", NULL};
         run_result r = run_cli(args);
         check_run(&r, 1, "garbage.ply"); /* out of range: PARSE or INVALID_INPUT, either names the file */
@@ -350,7 +315,7 @@ static void test_nonfinite_and_garbage_values(void **state) {
 static void test_truncated_and_lying_files(void **state) {
     (void)state;
     /* Binary PLY that declares more vertices than it holds, and one cut mid-value. */
-    const char *ply = path_of("short.ply");
+    const char *ply = scratch_path("short.ply");
     put_ply_le(ply, g_sphere, N_SPHERE, 0);
     FILE *f = fopen(ply, "r+b");
     assert_non_null(f);
@@ -360,14 +325,14 @@ static void test_truncated_and_lying_files(void **state) {
     assert_int_equal(truncate(ply, size - 24 * 1000 - 5), 0);
     expect_failure(ply, "GMPU_ERROR_PARSE", "file ends after 1999");
     /* A header that claims a billion vertices: fails at once, without allocating them. */
-    const char *liar = path_of("liar.ply");
+    const char *liar = scratch_path("liar.ply");
     put_text(liar, "ply\nformat binary_little_endian 1.0\nelement vertex 1000000000\nproperty double x\n"
                    "property double y\nproperty double z\nend_header\n\x01\x02\x03");
     double t0 = robust_now();
     expect_failure(liar, "GMPU_ERROR_PARSE", "expected 1000000000 vertices");
     assert_true(robust_now() - t0 < 5.0);
     /* OFF declaring 50 vertices, holding 3. */
-    const char *off = path_of("short.off");
+    const char *off = scratch_path("short.off");
     put_text(off, "OFF\n50 0 0\n0 0 0\n1 0 0\n0 1 0\n");
     expect_failure(off, "GMPU_ERROR_PARSE", "short.off");
     /* No end_header; an unknown PLY format; a PLY that is not one. */
@@ -386,7 +351,7 @@ static void test_truncated_and_lying_files(void **state) {
 /* A list property in the vertex element is skipped: the cloud still reconstructs. */
 static void test_list_property_in_vertex_element(void **state) {
     (void)state;
-    const char *in = path_of("listy.ply"), *out = path_of("listy.off");
+    const char *in = scratch_path("listy.ply"), *out = scratch_path("listy.off");
     put_ply_le(in, g_sphere, N_SPHERE, 1);
     const char *args[] = {in, "-o", out, "--quiet", "--resolution", "24", NULL};
     run_result r = run_cli(args);
@@ -404,7 +369,7 @@ static void test_extreme_scales(void **state) {
     for (int k = 0; k < 2; ++k) {
         double c[3] = {3 * scales[k], -scales[k], 0};
         double *p = robust_sphere(N_SPHERE, c, scales[k], 10 + (uint64_t)k);
-        const char *in = path_of("scaled.ply"), *out = path_of("scaled.off");
+        const char *in = scratch_path("scaled.ply"), *out = scratch_path("scaled.off");
         put_ply_le(in, p, N_SPHERE, 0);
         const char *args[] = {in, "-o", out, "--quiet", "--resolution", "24", NULL};
         run_result r = run_cli(args);
@@ -416,7 +381,7 @@ static void test_extreme_scales(void **state) {
     /* Beyond what normalises: a clean error. */
     double c[3] = {0, 0, 0};
     double *p = robust_sphere(200, c, 1e305, 11);
-    const char *in = path_of("huge.ply");
+    const char *in = scratch_path("huge.ply");
     put_ply_le(in, p, 200, 0);
     expect_failure(in, "GMPU_ERROR_INVALID_INPUT", "rescale the points");
     free(p);
@@ -424,23 +389,23 @@ static void test_extreme_scales(void **state) {
 
 static void test_outputs(void **state) {
     (void)state;
-    const char *in = path_of("sphere.xyz");
+    const char *in = scratch_path("sphere.xyz");
     put_xyz(in, g_sphere, N_SPHERE);
     /* Into a missing directory, or with an unknown extension: nothing written. */
-    const char *deep = path_of("no/such/dir/out.ply");
+    const char *deep = scratch_path("no/such/dir/out.ply");
     const char *a1[] = {in, "-o", deep, "--quiet", "--resolution", "24", NULL};
     run_result r = run_cli(a1);
     check_run(&r, 1, "No such file or directory");
     assert_non_null(strstr(r.err, "out.ply"));
-    const char *stl = path_of("out.stl");
+    const char *stl = scratch_path("out.stl");
     const char *a2[] = {in, "-o", stl, "--quiet", "--resolution", "24", NULL};
     r = run_cli(a2);
     check_run(&r, 1, "'.stl'");
     assert_false(exists(stl));
     /* An existing output survives a failed run untouched. */
-    const char *out = path_of("out.ply");
+    const char *out = scratch_path("out.ply");
     put_text(out, "previous result");
-    const char *missing = path_of("missing.xyz");
+    const char *missing = scratch_path("missing.xyz");
     const char *a3[] = {missing, "-o", out, "--quiet", NULL};
     r = run_cli(a3);
     check_run(&r, 1, "missing.xyz");
@@ -452,8 +417,8 @@ static void test_outputs(void **state) {
     assert_string_equal(buf, "previous result");
     remove(out);
     /* --normals-out that cannot be written: all or nothing, the mesh is removed too. */
-    const char *off = path_of("out.off");
-    const char *a4[] = {in, "-o", off, "--normals-out", path_of("no/dir/n.ply"), "--quiet", "--resolution", "24", NULL};
+    const char *off = scratch_path("out.off");
+    const char *a4[] = {in, "-o", off, "--normals-out", scratch_path("no/dir/n.ply"), "--quiet", "--resolution", "24", NULL};
     r = run_cli(a4);
     check_run(&r, 1, "no/dir/n.ply");
     assert_false(exists(off));
@@ -475,15 +440,15 @@ static void test_outputs(void **state) {
     check_run(&r, 0, "3000 points");
     const double c[3] = {0, 0, 0};
     check_off_sphere(off, c, 1.0, 0.05);
-    assert_int_equal(count_entries_starting("out."), 1); /* no temporaries left beside it */
+    assert_int_equal(scratch_count(scratch_dir, "out."), 1); /* no temporaries left beside it */
     remove(off);
 }
 
 static void test_bad_usage(void **state) {
     (void)state;
-    const char *in = path_of("sphere.xyz");
+    const char *in = scratch_path("sphere.xyz");
     put_xyz(in, g_sphere, N_SPHERE);
-    const char *out = path_of("out.ply");
+    const char *out = scratch_path("out.ply");
     struct {
         const char *args[8];
         int status;
@@ -515,7 +480,7 @@ static void test_bad_usage(void **state) {
 
 int main(void) {
     const struct CMUnitTest tests[] = {
-        cmocka_unit_test(test_missing_directory_and_unknown_inputs),
+        cmocka_unit_test(test_missinscratch_directory_and_unknown_inputs),
         cmocka_unit_test(test_too_few_and_degenerate_clouds),
         cmocka_unit_test(test_nonfinite_and_garbage_values),
         cmocka_unit_test(test_truncated_and_lying_files),
