@@ -3,14 +3,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/cancellable_sort.hpp"
+
 namespace gmpu {
 
 PointBuckets::PointBuckets(const BlockGrid &g, const std::vector<int64_t> &band, const SurfaceField &f,
                            Progress &progress, double fraction) {
-    auto checkpoint = [&] {
-        progress.report(fraction);
-        progress.throw_if_cancelled();
-    };
     const PointSet &points = f.points();
     // 1. Representatives: sort by voxel, keep the first (lowest index) of each.
     const double voxel = 0.5 * g.h;
@@ -21,20 +19,7 @@ PointBuckets::PointBuckets(const BlockGrid &g, const std::vector<int64_t> &band,
                         uint64_t(std::max(0.0, v[2])) << 42,
                     i};
     }
-    // Sorted in slices, then merged pairwise, checking in between: a single sort of a
-    // million pairs would leave the progress callback silent for too long.
-    checkpoint();
-    const size_t slice = 1u << 16;
-    for (size_t b = 0; b < keyed.size(); b += slice) {
-        std::sort(keyed.begin() + long(b), keyed.begin() + long(std::min(keyed.size(), b + slice)));
-        checkpoint();
-    }
-    for (size_t width = slice; width < keyed.size(); width *= 2)
-        for (size_t b = 0; b + width < keyed.size(); b += 2 * width) {
-            std::inplace_merge(keyed.begin() + long(b), keyed.begin() + long(b + width),
-                               keyed.begin() + long(std::min(keyed.size(), b + 2 * width)));
-            checkpoint();
-        }
+    cancellable_sort(keyed, progress, fraction);
     std::vector<uint32_t> rep, count;
     for (size_t k = 0; k < keyed.size(); ++k) {
         if (k > 0 && keyed[k].first == keyed[k - 1].first) {
@@ -67,13 +52,13 @@ PointBuckets::PointBuckets(const BlockGrid &g, const std::vector<int64_t> &band,
                     if (b >= 0) visit(size_t(b));
                 }
     };
-    checkpoint();
+    progress.poll(fraction);
     offsets.assign(band.size() + 1, 0);
     for (uint32_t p : rep) for_blocks(p, [&](size_t b) { ++offsets[b + 1]; });
     for (size_t b = 0; b < band.size(); ++b) offsets[b + 1] += offsets[b];
     point.resize(offsets.back());
     weight.resize(offsets.back());
-    checkpoint();
+    progress.poll(fraction);
     std::vector<uint32_t> fill(offsets.begin(), offsets.end() - 1);
     for (size_t k = 0; k < rep.size(); ++k)
         for_blocks(rep[k], [&](size_t b) {

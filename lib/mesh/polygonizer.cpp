@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/cancellable_sort.hpp"
 #include "core/parallel.hpp"
 #include "mesh/block_grid.hpp"
 #include "mesh/marching_tetrahedra.hpp"
@@ -215,19 +216,7 @@ Mesh weld(std::vector<BlockOutput> &blocks, const Normalisation &norm, Progress 
         progress.poll(0.95);
         for (size_t v = 0; v < blocks[b].vertex_key.size(); ++v) keyed.push_back({blocks[b].vertex_key[v], uint64_t(b) << 32 | v});
     }
-    // Sorted in slices, then merged pass by pass, polling progress in between: one std::sort
-    // of a million keys takes ~100 ms, past the callback's 50 ms cadence (and a cancel).
-    constexpr size_t kSlice = size_t(1) << 15;
-    for (size_t lo = 0; lo < keyed.size(); lo += kSlice) {
-        progress.poll(0.96);
-        std::sort(keyed.begin() + long(lo), keyed.begin() + long(std::min(keyed.size(), lo + kSlice)));
-    }
-    for (size_t width = kSlice; width < keyed.size(); width *= 2)
-        for (size_t lo = 0; lo + width < keyed.size(); lo += 2 * width) {
-            progress.poll(0.96);
-            std::inplace_merge(keyed.begin() + long(lo), keyed.begin() + long(lo + width),
-                               keyed.begin() + long(std::min(keyed.size(), lo + 2 * width)));
-        }
+    cancellable_sort(keyed, progress, 0.96);
 
     Mesh mesh;
     std::vector<std::vector<uint32_t>> remap(blocks.size());

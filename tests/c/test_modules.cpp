@@ -11,6 +11,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "core/cancellable_sort.hpp"
 #include "core/error.hpp"
 #include "core/parallel.hpp"
 #include "core/progress.hpp"
@@ -376,6 +377,26 @@ void parallel_for_rethrows_and_cancels(void **) {
     assert_int_equal(status_of([&] { cancelling.throw_if_cancelled(); }), GMPU_ERROR_CANCELLED);
 }
 
+void cancellable_sort_sorts_and_cancels(void **) {
+    // Not a multiple of the 32k slice, with duplicates: the last partial slice and merges of
+    // unequal runs are exercised.
+    std::mt19937_64 rng(3);
+    std::vector<std::pair<uint64_t, uint32_t>> v(100003), expected;
+    for (size_t i = 0; i < v.size(); ++i) v[i] = {rng() % 5000, uint32_t(i)};
+    expected = v;
+    std::sort(expected.begin(), expected.end());
+    Progress quiet(nullptr, nullptr, GMPU_STAGE_POLYGONIZE);
+    cancellable_sort(v, quiet, 0.5);
+    assert_true(v == expected);
+    // A callback that cancels: the sort stops with CANCELLED at its first poll.
+    int calls = 0;
+    Progress cancelling([](void *user, gmpu_stage, double) -> int { return ++*static_cast<int *>(user) >= 1; }, &calls,
+                        GMPU_STAGE_POLYGONIZE);
+    std::vector<int> w(70000, 1);
+    assert_int_equal(status_of([&] { cancellable_sort(w, cancelling, 0.5); }), GMPU_ERROR_CANCELLED);
+    assert_int_equal(calls, 1);
+}
+
 }  // namespace
 
 int main(void) {
@@ -396,6 +417,7 @@ int main(void) {
         cmocka_unit_test(unsupported_components_are_dropped),
         cmocka_unit_test(parallel_for_runs_each_index_once),
         cmocka_unit_test(parallel_for_rethrows_and_cancels),
+        cmocka_unit_test(cancellable_sort_sorts_and_cancels),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
