@@ -7,6 +7,7 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <utility>
 
 #include "api/guard.hpp"
 #include "api/handles.hpp"
@@ -61,6 +62,15 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+// A long stage (fit, orient, polygonize) behind the exception firewall. Whether it succeeds
+// or fails, its temporaries are freed by the time it returns: hand them back to the OS.
+template <class Body>
+gmpu_status run_stage(gmpu_surface *s, Body &&body) noexcept {
+    const gmpu_status status = guarded(s ? &s->last_error : nullptr, std::forward<Body>(body));
+    gmpu::release_free_memory();
+    return status;
+}
 
 struct ParamSpec {
     double lo, hi;
@@ -322,7 +332,7 @@ GMPU_API gmpu_status gmpu_surface_set_normals_f32(gmpu_surface *s, const float *
 GMPU_API size_t gmpu_surface_point_count(const gmpu_surface *s) { return s ? s->points.size() : 0; }
 
 GMPU_API gmpu_status gmpu_surface_fit(gmpu_surface *s) {
-    const gmpu_status status = guarded(s ? &s->last_error : nullptr, [&] {
+    return run_stage(s, [&] {
         require_arg(s, "surface");
         s->require(gmpu_surface::Stage::points, "gmpu_surface_fit", "gmpu_surface_set_points");
         auto t0 = Clock::now();
@@ -339,12 +349,10 @@ GMPU_API gmpu_status gmpu_surface_fit(gmpu_surface *s) {
         s->stage = gmpu_surface::Stage::fitted;
         s->seconds[GMPU_STAGE_FIT] = since(t0);
     });
-    gmpu::release_free_memory();  // the stage's temporaries, freed by now
-    return status;
 }
 
 GMPU_API gmpu_status gmpu_surface_orient(gmpu_surface *s) {
-    const gmpu_status status = guarded(s ? &s->last_error : nullptr, [&] {
+    return run_stage(s, [&] {
         require_arg(s, "surface");
         s->require(gmpu_surface::Stage::fitted, "gmpu_surface_orient", "gmpu_surface_fit");
         auto t0 = Clock::now();
@@ -372,8 +380,6 @@ GMPU_API gmpu_status gmpu_surface_orient(gmpu_surface *s) {
         s->stage = gmpu_surface::Stage::oriented;
         s->seconds[GMPU_STAGE_ORIENT] = since(t0);
     });
-    gmpu::release_free_memory();  // the stage's temporaries, freed by now
-    return status;
 }
 
 GMPU_API gmpu_status gmpu_surface_evaluate(const gmpu_surface *s, const double *xyz, size_t count, double *values,
@@ -416,7 +422,7 @@ GMPU_API gmpu_status gmpu_surface_copy_normals(const gmpu_surface *s, double *ou
 }
 
 GMPU_API gmpu_status gmpu_surface_polygonize(gmpu_surface *s, gmpu_mesh **out) {
-    const gmpu_status status = guarded(s ? &s->last_error : nullptr, [&] {
+    return run_stage(s, [&] {
         require_arg(s, "surface");
         require_arg(out, "out");
         *out = nullptr;
@@ -433,8 +439,6 @@ GMPU_API gmpu_status gmpu_surface_polygonize(gmpu_surface *s, gmpu_mesh **out) {
         s->seconds[GMPU_STAGE_POLYGONIZE] = since(t0);
         *out = mesh.release();
     });
-    gmpu::release_free_memory();  // the stage's temporaries, freed by now
-    return status;
 }
 
 }  // extern "C"
