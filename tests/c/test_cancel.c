@@ -262,8 +262,8 @@ static void finish_pipeline(gmpu_surface *s, gmpu_stage from, watch *w) {
     gmpu_mesh_destroy(m);
 }
 
-/* Cancels `stage` on s after `delay` seconds; returns the latency (or -1 if the stage
- * finished before the callback could cancel it). */
+/* Cancels `stage` on s after `delay` seconds; returns the latency, or, if the stage
+ * finished before the callback could cancel it, minus the stage's duration. */
 static double cancel_once(gmpu_surface *s, watch *w, gmpu_stage stage, double delay) {
     double cells_before = 0;
     assert_ok(gmpu_surface_get_stat(s, GMPU_STAT_CELLS, &cells_before));
@@ -274,7 +274,7 @@ static double cancel_once(gmpu_surface *s, watch *w, gmpu_stage stage, double de
     if (w->cancelled_at == 0) {
         assert_ok(st); /* finished before the delay: nothing to measure */
         gmpu_mesh_destroy(m);
-        return -1;
+        return -(end - w->start); /* minus how long the stage took this time */
     }
     if (st != GMPU_ERROR_CANCELLED)
         fail_msg("%s cancelled after %.3f s returned %s (%s)", stage_name(stage), w->cancelled_at - w->start,
@@ -316,7 +316,9 @@ static void cancel_stage(gmpu_stage stage) {
         for (int attempt = 0; attempt < 4; ++attempt) {
             double latency = cancel_once(s, &w, stage, at);
             if (latency < 0) {
-                at *= 0.9;  /* this run was quicker than the timed one: aim a little earlier */
+                /* This run was quicker than the timed one (the machine got quieter): aim at
+                 * the same share of the stage as it runs now, and a little earlier. */
+                at = fmin(at, delay / duration * -latency) * 0.9;
                 continue;
             }
             best = fmin(best, latency);
