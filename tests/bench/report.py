@@ -4,6 +4,7 @@ import math
 import statistics
 from pathlib import Path
 
+import binding_cost
 import render
 
 PIPELINE_LABELS = {"gmpu": "gmpu", "open3d_d8": "Open3D (Poisson d8)",
@@ -186,6 +187,8 @@ def targets(results):
         bpp = g["peak_rss_mb"] * 2**20 / g["points"]
         out.append(f"- 1M points, peak memory ≤ {BYTES_PER_POINT_TARGET} bytes per point: "
                    f"{'met' if bpp <= BYTES_PER_POINT_TARGET else 'missed'} ({bpp:.0f} B/point).")
+    if results.get("binding"):
+        out.append("- " + binding_cost.summary(results["binding"]))
     return "\n".join(out) + "\n" if out else "_No gmpu runs: targets not assessed._\n"
 
 
@@ -310,7 +313,7 @@ def write_all(results, out_dir, renders=True):
         "and peak memory are the whole child process. gmpu's figures are those of the median "
         "of 3 runs where a run takes under 10 s (one run of a third of a second varies by "
         "±30 % on a shared machine); the peers, at seconds to minutes, run once." + load_note(rows + scale) + "\n\n"
-        "### Targets (issue 5)\n\n" + targets(results) + "\n"
+        "### Targets (issues 3 and 5)\n\n" + targets(results) + "\n"
         "### Over all clouds\n\n" + summary_table(rows) + "\n"
         "### Scale series\n\n" + scale_table(scale) + "\n"
         + ("![time vs points](time_vs_points.png) ![memory vs points](memory_vs_points.png)\n\n"

@@ -5,6 +5,7 @@ same clouds, in the same run, and are scored by the same exact metrics (gmpu-met
     make bench          every cloud in ../shared/data/clouds, clouds sampled here from every
                         ground-truth mesh, a 10k → 1M scale series; table, plots, pictures
     make bench-quick    gmpu alone on two clouds; exits 1 when a quality floor is missed
+                        (and prints what the Python binding costs against the CLI)
 
 Results go to bench-results/ (results.json, results.md, *.png, renders/); then
 tests/bench/update_readme.py puts the summary into the README.
@@ -21,6 +22,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+import binding_cost  # noqa: E402
 import pipelines  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -210,7 +212,10 @@ def quick(args, metrics_exe, build):
             ok = value is True if floor is True else value is not None and value >= floor
             if not ok:
                 failures.append(f"{name}: {key} = {value} (floor {floor})")
-    save({"machine": machine(), "mode": "quick", "rows": rows}, args.out)
+    # Printed, not a floor: a timing on a shared machine must not fail CI at random.
+    binding = binding_cost.measure(build, shared["bunny_clean"].path, pairs=5)
+    print(binding_cost.summary(binding))
+    save({"machine": machine(), "mode": "quick", "rows": rows, "binding": binding}, args.out)
     for f in failures:
         print(f"FLOOR MISSED  {f}")
     checks = sum(len(floors) for floors in QUICK_FLOORS.values())
@@ -232,6 +237,12 @@ def full(args, metrics_exe, build):
         for p in chosen:
             results["rows"].append(run_one(p, cloud, args.out, metrics_exe, args.timeout, args.samples))
             save(results, args.out)
+
+    bunny = next((c for c in clouds if c.name == "bunny_clean"), None)
+    if bunny and any(p.name == "gmpu" for p in chosen):
+        results["binding"] = binding_cost.measure(build, bunny.path, pairs=15)
+        print(binding_cost.summary(results["binding"]), flush=True)
+        save(results, args.out)
 
     if args.scale:
         mesh = args.meshes / SCALE_MODEL
