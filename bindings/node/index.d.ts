@@ -70,19 +70,19 @@ export interface Parameters {
     minPoints?: number;
     /** α: support radius = α × cell diagonal. Default 0.75, [0.5, 2]. */
     supportScale?: number;
-    /** Piecewise quadrics at sharp edges and corners. Default true. */
+    /** Piecewise quadrics at sharp edges and corners. Default false (0). */
     sharpFeatures?: boolean | number;
-    /** Polygonize grid cubes along the longest side; 0 (default) picks from the octree; or 8..4096. */
+    /** Polygonize grid cubes along the longest side; 0 picks from the octree; or 8..4096. Default 0. */
     resolution?: number;
-    /** Level of detail: use octree cells down to this level only; 0 (default) = all. */
+    /** Level of detail: use octree cells down to this level only; 0 = all. Default 0. */
     level?: number;
-    /** Worker threads; 0 (default) = every core. */
+    /** Worker threads; 0 = every core. Default 0. */
     threads?: number;
     /** Cap on octree cells (GMPU_ERROR_LIMIT_EXCEEDED beyond). Default 2e7. */
     maxCells?: number;
     /** Cap on polygonize triangles. Default 1e8. */
     maxTriangles?: number;
-    /** Noise floor for ε, in units of the estimated noise; 0 = off. Default 3, [0, 20]. */
+    /** Noise floor for ε, in units of the estimated noise; 0 = off. Default 2, [0, 20]. */
     noiseScale?: number;
 }
 export type ParameterName = keyof Parameters;
@@ -101,6 +101,15 @@ export interface ReconstructOptions extends SurfaceOptions {
 export interface PolygonizeOptions {
     resolution?: number;
     level?: number;
+}
+
+/**
+ * For the ...Async stages: aborting the signal cancels the running stage at its next
+ * progress report (within about 100 ms, when the event loop is free to deliver it); the
+ * promise rejects with GMPU_ERROR_CANCELLED whose `cause` is the signal's reason.
+ */
+export interface AsyncOptions {
+    signal?: AbortSignal | null;
 }
 
 /** The statistics (gmpu_stat) of the latest completed stages, by name. */
@@ -191,12 +200,33 @@ export declare class Surface {
     normals(): Float64Array;
     /** gmpu_surface_polygonize: the zero set as a closed mesh (copied into JS arrays). */
     polygonize(options?: PolygonizeOptions): Mesh;
-    /** gmpu_surface_destroy. Idempotent. (Also available as [Symbol.dispose] where the runtime has it.) */
+    /**
+     * The stages without blocking the event loop: the C call runs on a worker thread and
+     * onProgress is delivered on this thread. Until the promise settles, every other method
+     * of this Surface throws GMPU_ERROR_WRONG_ORDER ("busy"); close() cancels the stage and
+     * frees the surface once it has returned. fitAsync(points) sets the points first
+     * (synchronously: they are copied).
+     */
+    fitAsync(points?: PointSource, options?: AsyncOptions): Promise<this>;
+    fitAsync(options?: AsyncOptions): Promise<this>;
+    orientAsync(options?: AsyncOptions): Promise<this>;
+    polygonizeAsync(options?: PolygonizeOptions & AsyncOptions): Promise<Mesh>;
+    /**
+     * gmpu_surface_destroy. Idempotent. During a stage (from onProgress, or while an async
+     * stage runs) it cancels the stage and frees the surface when the stage has returned.
+     * (Also available as [Symbol.dispose] where the runtime has it.)
+     */
     close(): void;
 }
 
 /** Points → fit → orient → polygonize in one call; the native surface is always freed. */
 export declare function reconstruct(points: PointSource, options?: ReconstructOptions): Mesh;
+
+/**
+ * reconstruct() without blocking the event loop (fit, orient and polygonize run on a worker
+ * thread; a path is read synchronously first). options.signal cancels.
+ */
+export declare function reconstructAsync(points: PointSource, options?: ReconstructOptions & AsyncOptions): Promise<Mesh>;
 
 /** gmpu_points_read: .ply (ascii / binary), .xyz / .txt, .off, .obj. */
 export declare function readPoints(path: string | URL): PointCloud;

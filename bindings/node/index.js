@@ -48,14 +48,15 @@ function lib() {
     }
 }
 
-// The error of a failed call: status name and message from the library. Every call here
-// runs on the JS thread, so gmpu_last_error() (thread-local, any function) is the message
-// of this failure. gmpu_surface_last_error(handle) is only a fallback: const calls
+// The error of a failed call: status name and message from the library. A synchronous
+// call runs on the JS thread, so gmpu_last_error() (thread-local, any function) is the
+// message of this failure. gmpu_surface_last_error(handle) is only a fallback: const calls
 // (evaluate, copy_normals, get_param, get_stat) do not set it, so it may hold an older one.
-function failure(status, handle) {
+// An async stage ran on a worker thread: its caller passes the surface's message.
+function failure(status, handle, message = null) {
     const n = lib();
     const code = statusNames[status] ?? n.status_name(status);
-    const message = n.last_error() || (handle ? n.surface_last_error(handle) : '') || code;
+    message ||= n.last_error() || (handle ? n.surface_last_error(handle) : '') || code;
     return new GmpuError(code, message);
 }
 
@@ -228,7 +229,8 @@ const finalizer = new FinalizationRegistry((cell) => {
  */
 export class Surface {
     #cell; // { ptr } shared with the finalizer
-    #busy = false; // inside fit / orient / polygonize (the progress callback may run)
+    #busy = false; // inside a synchronous fit / orient / polygonize (only onProgress can call in)
+    #running = false; // an ...Async stage is running on a worker thread
     #closeRequested = false;
 
     /** @type {((stage: string, fraction: number) => unknown) | null} */
@@ -279,13 +281,19 @@ export class Surface {
         if (this.#cell.ptr === null) throw invalidArgument('the Surface is closed');
         if (this.#busy)
             throw jsError('GMPU_ERROR_WRONG_ORDER', 'the Surface is busy: it cannot be used from its own progress callback');
+        if (this.#running)
+            throw jsError('GMPU_ERROR_WRONG_ORDER',
+                'the Surface is busy: an async stage is running (await it first, or cancel it with close() or its AbortSignal)');
         return this.#cell.ptr;
     }
 
-    /** Frees the native surface. Idempotent. Inside onProgress, cancels the running stage and frees it afterwards. */
+    /**
+     * Frees the native surface. Idempotent. Inside onProgress, or while an async stage runs,
+     * cancels the running stage and frees the surface when it has returned.
+     */
     close() {
         if (this.#cell.ptr === null) return;
-        if (this.#busy) {
+        if (this.#busy || this.#running) {
             this.#closeRequested = true;
             return;
         }
@@ -398,46 +406,103 @@ export class Surface {
      * apply to this call only (the surface's parameters are restored afterwards).
      */
     polygonize(options = {}) {
-        const overrides = Object.entries(options ?? {}).filter(([, v]) => v !== undefined);
-        for (const [name] of overrides)
-            if (name !== 'resolution' && name !== 'level')
-                throw invalidArgument(`unknown polygonize option '${name}' (options: resolution, level)`);
-        const saved = overrides.map(([name]) => [name, this.getParam(name)]);
         const out = [null];
+        const saved = this.#overrideForPolygonize(options);
         try {
-            for (const [name, value] of overrides) this.setParam(name, value);
             this.#stage((h) => lib().surface_polygonize(h, out));
         } catch (err) {
             // The stage may have completed while onProgress threw at its very end.
             if (out[0] !== null) lib().mesh_destroy(out[0]);
             throw err;
         } finally {
-            if (!this.closed) for (const [name, value] of saved) this.setParam(name, value);
+            this.#restoreParams(saved);
         }
         return takeMesh(out[0]);
+    }
+
+    // ---- the same stages without blocking the event loop ----
+    // Each runs the C stage on a koffi worker thread and resolves when it returns. Until
+    // then every other method of this Surface throws "busy" (they would otherwise wait for
+    // the stage, blocking the event loop); close() and `signal` cancel the stage.
+
+    /** fit() on a worker thread; with `points`, sets them first (synchronously: they are copied). */
+    async fitAsync(pointsOrOptions, options) {
+        if (isPointSource(pointsOrOptions)) this.setPoints(pointsOrOptions);
+        else options ??= pointsOrOptions;
+        await this.#stageAsync('surface_fit', [], signalOf(options));
+        return this;
+    }
+
+    /** orient() on a worker thread. */
+    async orientAsync(options) {
+        await this.#stageAsync('surface_orient', [], signalOf(options));
+        return this;
+    }
+
+    /** polygonize() on a worker thread; options as polygonize's, plus `signal`. */
+    async polygonizeAsync(options = {}) {
+        const { signal, ...overrides } = options ?? {};
+        signalOf({ signal });
+        const out = [null];
+        const saved = this.#overrideForPolygonize(overrides);
+        try {
+            await this.#stageAsync('surface_polygonize', [out], signal);
+        } catch (err) {
+            if (out[0] !== null) lib().mesh_destroy(out[0]);
+            throw err;
+        } finally {
+            this.#restoreParams(saved);
+        }
+        return takeMesh(out[0]);
+    }
+
+    // Sets polygonize's per-call parameters; returns the values to restore.
+    #overrideForPolygonize(options) {
+        const overrides = Object.entries(options ?? {}).filter(([, v]) => v !== undefined);
+        for (const [name] of overrides)
+            if (name !== 'resolution' && name !== 'level')
+                throw invalidArgument(`unknown polygonize option '${name}' (options: resolution, level)`);
+        const saved = overrides.map(([name]) => [name, this.getParam(name)]);
+        try {
+            for (const [name, value] of overrides) this.setParam(name, value);
+        } catch (err) {
+            this.#restoreParams(saved);
+            throw err;
+        }
+        return saved;
+    }
+
+    #restoreParams(saved) {
+        if (!this.closed) for (const [name, value] of saved) this.setParam(name, value);
+    }
+
+    // The progress callback of one stage run, or null when the run needs none. It forwards
+    // to onProgress and returns 1 (cancel) once onProgress has thrown or returned false,
+    // close() was called, or run.signal has aborted.
+    #progressCallback(n, run, always) {
+        const user = this.onProgress;
+        if (user !== null && user !== undefined && typeof user !== 'function')
+            throw invalidArgument('onProgress must be a function');
+        if (!user && !always) return null;
+        return koffi.register((_user, stage, fraction) => {
+            if (run.thrown !== null || this.#closeRequested || run.signal?.aborted) return 1;
+            if (!user) return 0;
+            try {
+                const result = user(STAGES[stage] ?? String(stage), fraction);
+                return result === false || this.#closeRequested ? 1 : 0;
+            } catch (err) {
+                run.thrown = { err };
+                return 1;
+            }
+        }, n.progressType);
     }
 
     // Runs one stage with the progress callback registered for its duration only.
     #stage(call) {
         const h = this.#handle();
         const n = lib();
-        const user = this.onProgress;
-        if (user !== null && user !== undefined && typeof user !== 'function')
-            throw invalidArgument('onProgress must be a function');
-        let thrown = null;
-        let callback = null;
-        if (user) {
-            callback = koffi.register((_user, stage, fraction) => {
-                if (thrown !== null || this.#closeRequested) return 1;
-                try {
-                    const result = user(STAGES[stage] ?? String(stage), fraction);
-                    return result === false || this.#closeRequested ? 1 : 0;
-                } catch (err) {
-                    thrown = { err };
-                    return 1;
-                }
-            }, n.progressType);
-        }
+        const run = { thrown: null, signal: null };
+        const callback = this.#progressCallback(n, run, false);
         let error = null;
         try {
             if (callback !== null) check(n.surface_set_progress(h, callback, null), h);
@@ -454,13 +519,67 @@ export class Surface {
                 koffi.unregister(callback);
             }
         }
+        this.#endStage(run, error);
+    }
+
+    // The async twin of #stage: the C call runs on a koffi worker thread; koffi queues its
+    // progress callbacks to this thread, so they run whenever the event loop is free. The
+    // callback is always installed, so that close() and the signal can cancel.
+    async #stageAsync(name, args, signal) {
+        const h = this.#handle();
+        const n = lib();
+        const stage = name.replace('surface_', '');
+        if (signal?.aborted) throw cancelledBy(signal, `${stage} not started: the signal was already aborted`);
+        const run = { thrown: null, signal };
+        const callback = this.#progressCallback(n, run, true);
+        let status;
+        try {
+            check(n.surface_set_progress(h, callback, null), h);
+            this.#running = true;
+            try {
+                status = await new Promise((resolve, reject) =>
+                    n[name].async(h, ...args, (err, value) => (err ? reject(err) : resolve(value))));
+            } finally {
+                this.#running = false;
+            }
+        } finally {
+            n.surface_set_progress(h, null, null);
+            koffi.unregister(callback);
+        }
+        let error = null;
+        if (status !== 0) {
+            // gmpu_last_error() is the worker thread's; the surface keeps the stage's message.
+            error = failure(status, null, n.surface_last_error(h));
+            if (status === Status.GMPU_ERROR_CANCELLED && signal?.aborted && run.thrown === null)
+                error = cancelledBy(signal, `${stage} cancelled by its AbortSignal`);
+        }
+        this.#endStage(run, error);
+    }
+
+    // After a stage: a close() requested meanwhile happens now; then the error, if any.
+    #endStage(run, error) {
         if (this.#closeRequested) {
             this.#closeRequested = false;
             this.close();
         }
-        if (thrown !== null) throw thrown.err;
+        if (run.thrown !== null) throw run.thrown.err;
         if (error !== null) throw error;
     }
+}
+
+// options.signal, checked: an AbortSignal or nothing.
+function signalOf(options) {
+    const signal = options?.signal;
+    if (signal === undefined || signal === null) return null;
+    if (typeof signal !== 'object' || typeof signal.aborted !== 'boolean')
+        throw invalidArgument('signal must be an AbortSignal');
+    return signal;
+}
+
+// The rejection of a stage cancelled through its AbortSignal: GMPU_ERROR_CANCELLED, with
+// the signal's reason as the cause.
+function cancelledBy(signal, what) {
+    return new GmpuError('GMPU_ERROR_CANCELLED', `GMPU_ERROR_CANCELLED: ${what}`, { cause: signal.reason });
 }
 
 if (typeof Symbol.dispose === 'symbol') {
@@ -511,6 +630,26 @@ export function reconstruct(points, options = {}) {
     const surface = new Surface(points, options);
     try {
         return surface.fit().orient().polygonize();
+    } finally {
+        surface.close();
+    }
+}
+
+/**
+ * reconstruct() without blocking the event loop: fit, orient and polygonize run on a
+ * worker thread. options.signal (an AbortSignal) cancels; the promise then rejects with
+ * GMPU_ERROR_CANCELLED (cause: the signal's reason). A path is read synchronously first.
+ */
+export async function reconstructAsync(points, options = {}) {
+    if (!isPointSource(points)) throw invalidArgument(`points must be point coordinates, a PointCloud or a path; got ${describe(points)}`);
+    if (options === null || typeof options !== 'object') throw invalidArgument('options must be an object');
+    const { signal, ...rest } = options;
+    signalOf({ signal });
+    const surface = new Surface(points, rest);
+    try {
+        await surface.fitAsync({ signal });
+        await surface.orientAsync({ signal });
+        return await surface.polygonizeAsync({ signal });
     } finally {
         surface.close();
     }

@@ -54,6 +54,22 @@ test('every function of the C header is declared in lib/native.js', () => {
     assert.deepEqual(missing, []);
 });
 
+test('the defaults index.d.ts documents are the library\'s', () => {
+    const s = new gmpu.Surface();
+    try {
+        const actual = s.params();
+        const body = dts.slice(dts.indexOf('export interface Parameters'));
+        const documented = [...body.slice(0, body.indexOf('\n}')).matchAll(/Default (false|true|[\d.e]+)[^\n]*\n\s*(\w+)\?:/g)];
+        assert.equal(documented.length, gmpu.parameterNames.length, 'one "Default" per parameter');
+        for (const [, text, name] of documented) {
+            const value = text === 'false' ? 0 : text === 'true' ? 1 : Number(text.replace(/\.$/, ''));
+            assert.equal(value, actual[name], `${name}: index.d.ts says Default ${text}, the library has ${actual[name]}`);
+        }
+    } finally {
+        s.close();
+    }
+});
+
 test('GmpuError is an Error with code, status and the C message', () => {
     let err;
     try {
@@ -80,12 +96,27 @@ test('index.d.ts type-checks typical use and rejects misuse (tsc --strict)', (t)
     fs.mkdirSync(path.join(dir, 'node_modules'));
     fs.symlinkSync(packageDir, path.join(dir, 'node_modules', 'gmpu'));
     fs.writeFileSync(path.join(dir, 'package.json'), '{ "type": "module" }\n');
-    // The only non-ES2022 global index.d.ts uses (declared by @types/node and lib.dom, both
-    // slow to load): a minimal stand-in keeps this check at well under a second of CPU.
-    fs.writeFileSync(path.join(dir, 'url.d.ts'), 'declare class URL { constructor(url: string); readonly href: string; }\n');
+    // The only non-ES2022 globals index.d.ts uses (declared by @types/node and lib.dom, both
+    // slow to load): minimal stand-ins keep this check at well under a second of CPU.
+    fs.writeFileSync(path.join(dir, 'url.d.ts'), 'declare class URL { constructor(url: string); readonly href: string; }\n' +
+        'declare class AbortSignal { readonly aborted: boolean; readonly reason: unknown; }\n' +
+        'declare class AbortController { readonly signal: AbortSignal; abort(reason?: unknown): void; }\n');
     fs.writeFileSync(path.join(dir, 'use.ts'), `
-import { reconstruct, readPoints, writeMesh, writePoints, Surface, GmpuError, Status, libraryInfo,
+import { reconstruct, reconstructAsync, readPoints, writeMesh, writePoints, Surface, GmpuError, Status, libraryInfo,
          parameterNames, statisticNames, type Mesh, type Stage, type Statistics } from 'gmpu';
+
+async function inTheBackground(points: Float64Array): Promise<Mesh> {
+    const controller = new AbortController();
+    const one: Mesh = await reconstructAsync(points, { resolution: 32, signal: controller.signal });
+    const s = new Surface(points);
+    const fitted: Surface = await s.fitAsync({ signal: null });
+    await (await fitted.orientAsync()).polygonizeAsync({ level: 3, signal: controller.signal });
+    await s.fitAsync(points, { signal: controller.signal });
+    // @ts-expect-error a signal is an AbortSignal
+    await reconstructAsync(points, { signal: 'stop' });
+    return one;
+}
+export { inTheBackground };
 
 const cloud = readPoints(new URL('file:///tmp/cloud.ply'));
 const mesh: Mesh = reconstruct(cloud.positions, { resolution: 64, sharpFeatures: false,

@@ -35,6 +35,7 @@ test('the README Node.js example runs', (t) => {
     assert.equal(mesh.vertices.length / 3, vertices);
     assert.equal(mesh.faces.length / 3, triangles);
     assertWatertight(mesh, 'README mesh');
+    assert.match(r.stdout, new RegExp(`\nasync: ${triangles} triangles\n`), 'reconstructAsync gave another mesh');
     const f = r.stdout.match(/f = (-?[\d.]+) inside, (-?[\d.]+) outside/);
     assert.ok(f, r.stdout);
     assert.ok(Number(f[1]) > 0 && Number(f[2]) < 0, `signs of f: ${f[0]}`);
