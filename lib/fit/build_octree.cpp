@@ -15,6 +15,11 @@ namespace {
 
 // Supports larger than this (estimated) are taken from the coarse subsample.
 constexpr double kFullSupport = 16384;
+// A leaf that misses ε but has no child near the data is "stranded" (typically a coarse
+// cell beside a sharp corner, whose cube holds no point). Its blending weight is scaled by
+// (ε / error)^kStrandedPower: where finer leaves reach, they decide; where none does, it
+// still stands in.
+constexpr double kStrandedPower = 2.0;
 
 struct Builder {
     const PointSet &points;
@@ -175,7 +180,11 @@ struct Builder {
             std::vector<uint32_t> next;
             for (size_t i = 0; i < level.size(); ++i) {
                 uint32_t parent = level[i];
-                if (kids[i].empty()) continue;  // stays a leaf
+                if (kids[i].empty()) {  // stays a leaf, although its fit misses ε
+                    Cell &stranded = tree.cells[parent];
+                    stranded.blend_factor = float(std::pow(epsilon / double(stranded.error), kStrandedPower));
+                    continue;
+                }
                 tree.cells[parent].first_child = int32_t(tree.cells.size());
                 for (auto &k : kids[i]) {
                     tree.cells[parent].child_mask |= uint8_t(1u << k.cell.first_child);

@@ -48,12 +48,12 @@ double MpuFunction::blend(const std::vector<uint32_t> &leaves, const Eigen::Vect
         if (d2 >= c.radius * c.radius) continue;
         const double d = std::sqrt(d2);
         const double t = 1.5 * d / c.radius;
-        const double w = bspline(t);
+        const double w = c.blend_factor * bspline(t);
         const double q = c.value(x, tree_.pieces, gradient ? &g : nullptr);
         sw += w;
         swq += w * q;
         if (gradient) {
-            Eigen::Vector3d dw = d > 0.0 ? Eigen::Vector3d(bspline_derivative(t) * 1.5 / (c.radius * d) * y)
+            Eigen::Vector3d dw = d > 0.0 ? Eigen::Vector3d(c.blend_factor * bspline_derivative(t) * 1.5 / (c.radius * d) * y)
                                          : Eigen::Vector3d::Zero();
             dw_sum += dw;
             dwq_sum += dw * q + w * g;

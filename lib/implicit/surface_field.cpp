@@ -12,6 +12,13 @@ constexpr size_t kNeighbours = 8;
 // gaps between samples so the trusted shell around the surface has no holes.
 constexpr double kTrustSpacings = 1.5;
 constexpr size_t kSideVotes = 8;
+// The winding number overrules the side test when it is within this of 0 or 1. Telling
+// 0 from 1 needs less accuracy than the far regions' sign (block_grid.cpp): cells count as
+// one dipole from 1.2 radii on instead of 2, which keeps the 1M-point polygonize within
+// about 0.15 s of what it cost without the check (at 2: +0.45 s) and changes no mesh we
+// measured by more than noise.
+constexpr double kDecisiveWinding = 0.25;
+constexpr double kWindingFarRatio = 1.2;
 constexpr double kFarAway = 1e6;  // normalised units: the data spans 1
 // Up to this many points, measure_points searches every point's neighbours.
 constexpr size_t kExactMeasureLimit = 1u << 17;
@@ -50,8 +57,16 @@ double SurfaceField::far_value(const Eigen::Vector3d &x, Eigen::Vector3d *gradie
         double side = (x - points_.point(i)).dot(n);
         vote += (side < 0.0 ? 1.0 : -1.0) / (std::sqrt(double(d2[k])) + 1e-12);
     }
-    const double sign = vote > 0.0 ? 1.0 : -1.0;  // behind the outward normals: inside
+    double sign = vote > 0.0 ? 1.0 : -1.0;  // behind the outward normals: inside
     const double distance = std::sqrt(double(d2[0]));
+    // The side test only sees the nearest points: far beyond a concave part (above a back
+    // between two humps, say) their normals can all face away from x and call it inside.
+    // The winding number sums every point; where it is clearly 0 or 1, it decides.
+    if (winding_ && !winding_->empty()) {
+        const double w = winding_->winding(x, kWindingFarRatio);
+        if (w > 1.0 - kDecisiveWinding) sign = 1.0;
+        else if (w < kDecisiveWinding) sign = -1.0;
+    }
     if (gradient) {
         Eigen::Vector3d away = x - points_.point(idx[0]);
         // f = sign · distance grows away from the point inside and falls outside.

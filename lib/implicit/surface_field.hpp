@@ -6,8 +6,9 @@
 // "trusted" when it lies within the trust radius of some input point (a few local
 // spacings, never less than two polygonizer cubes); there f is the MPU blend. Farther out
 // f = ±d(x), the distance to the nearest point, signed by which side of the nearby points'
-// oriented normals x lies on (Hoppe's test, voted over the 8 nearest points; reliable once
-// x is a few spacings away): continuous
+// oriented normals x lies on (Hoppe's test, voted over the 8 nearest points), unless the
+// winding number, when given, is clearly 0 or 1 there (it sees every point, and the
+// nearest ones can all face away from x beyond a concave part): continuous
 // enough at the border (the blend is about a signed distance too) and never zero, so no
 // surface can appear away from the data.
 #pragma once
@@ -19,6 +20,7 @@
 
 #include "geometry/point_set.hpp"
 #include "implicit/mpu_function.hpp"
+#include "implicit/winding_field.hpp"
 
 namespace gmpu {
 
@@ -37,9 +39,11 @@ public:
     // bounds the neighbour searches of untrusted queries (infinite for general use; the
     // polygonizer knows every query it makes has a point within its band's reach, and
     // bounded searches are much cheaper far from the data).
+    // `winding` (optional) overrules the far field's side test where the winding number is
+    // decisive (see far_value).
     SurfaceField(const MpuFunction &mpu, const PointSet &points, const PointMeasures &measures,
-                 double min_trust = 0.0, double reach = INFINITY)
-        : mpu_(mpu), points_(points), measures_(measures), min_trust_(min_trust), reach_(reach) {}
+                 double min_trust = 0.0, double reach = INFINITY, const WindingField *winding = nullptr)
+        : mpu_(mpu), points_(points), measures_(measures), min_trust_(min_trust), reach_(reach), winding_(winding) {}
 
     // f and optionally ∇f at x (normalised frame).
     double value(const Eigen::Vector3d &x, Eigen::Vector3d *gradient) const;
@@ -64,6 +68,7 @@ private:
     const PointSet &points_;
     const PointMeasures &measures_;
     double min_trust_, reach_;
+    const WindingField *winding_;
 };
 
 // Area and trust radius of every point, from its k-th neighbour distance (normals are

@@ -5,7 +5,6 @@
 namespace gmpu {
 
 namespace {
-constexpr double kFarRatio = 2.0;  // a cell is far when q is beyond twice its radius
 constexpr double kInv4Pi = 0.25 / M_PI;
 }  // namespace
 
@@ -32,13 +31,13 @@ WindingField::WindingField(const Octree &tree, const PointSet &points, const std
     }
 }
 
-double WindingField::visit(uint32_t index, const Eigen::Vector3d &q) const {
+double WindingField::visit(uint32_t index, const Eigen::Vector3d &q, double far_ratio2) const {
     const Cell &c = tree_->cells[index];
     if (c.point_end == c.point_begin) return 0.0;
     const Moment &m = moments_[index];
     Eigen::Vector3d r = m.centroid - q;
     double d2 = r.squaredNorm();
-    if (d2 > kFarRatio * kFarRatio * m.radius * m.radius)
+    if (d2 > far_ratio2 * m.radius * m.radius)
         return kInv4Pi * m.dipole.dot(r) / (d2 * std::sqrt(d2));
     if (c.is_leaf()) {
         double w = 0.0;
@@ -52,11 +51,13 @@ double WindingField::visit(uint32_t index, const Eigen::Vector3d &q) const {
     double w = 0.0;
     for (int o = 0; o < 8; ++o) {
         int32_t k = tree_->child(c, o);
-        if (k >= 0) w += visit(uint32_t(k), q);
+        if (k >= 0) w += visit(uint32_t(k), q, far_ratio2);
     }
     return w;
 }
 
-double WindingField::winding(const Eigen::Vector3d &q) const { return moments_.empty() ? 0.0 : visit(0, q); }
+double WindingField::winding(const Eigen::Vector3d &q, double far_ratio) const {
+    return moments_.empty() ? 0.0 : visit(0, q, far_ratio * far_ratio);
+}
 
 }  // namespace gmpu

@@ -24,7 +24,9 @@ public:
     WindingField(const Octree &tree, const PointSet &points, const std::vector<float> &normals,
                  const std::vector<float> &area, Progress *progress = nullptr);
 
-    double winding(const Eigen::Vector3d &q) const;
+    // far_ratio: a cell counts as one dipole once q is beyond far_ratio × its radius; a
+    // smaller ratio is cheaper and coarser (enough to tell 0 from 1 well away from the data).
+    double winding(const Eigen::Vector3d &q, double far_ratio = 2.0) const;
     bool empty() const { return moments_.empty(); }
 
 private:
@@ -33,7 +35,7 @@ private:
         Eigen::Vector3d dipole = Eigen::Vector3d::Zero();  // Σ A n
         double radius = 0.0;                               // of the points about the centroid
     };
-    double visit(uint32_t cell, const Eigen::Vector3d &q) const;
+    double visit(uint32_t cell, const Eigen::Vector3d &q, double far_ratio2) const;
     const Octree *tree_ = nullptr;
     const PointSet *points_ = nullptr;
     std::vector<Moment> moments_;  // per cell

@@ -121,14 +121,18 @@ void every_cloud(void **) {
         // The issue asks Chamfer ≤ 0.25 % and F@1 % ≥ 0.99 of clean clouds; we hold every
         // noise-free one to it, and noisy ones to looser bounds that still catch a regression.
         const double max_chamfer = noisy ? 0.004 : 0.0025, min_f1 = noisy ? 0.98 : 0.99;
+        // F@0.5 %, tighter: it is what sharp corners and spurious pockets cost (fandisk_clean
+        // 0.9964, knot_clean 0.9925 while coarse bad fits blended at full weight; 1.0000 and
+        // 1.0000 now; elephant_sparse5k 0.971 while the far field trusted the side test alone).
         bool ok = orientation >= min_orientation && check.watertight && check.nonmanifold_vertices == 0 &&
                   check.components == expected_components;
         // Topology too: the same handles as the ground truth, component by component — for
         // dense clouds. At 5k points (elephant_sparse5k) thin parts are a spacing or two
         // apart and an extra handle can bridge them; there it is reported, not asserted.
         const bool dense = cloud.size() >= 20000;
+        const double min_f05 = !dense ? 0.98 : noisy ? 0.995 : 0.998;
         if (scored) ok = ok && (!dense || genus == expected_genus) && cmp.chamfer_l1 <= max_chamfer &&
-                         cmp.fscore_at(0.01)->fscore >= min_f1;
+                         cmp.fscore_at(0.01)->fscore >= min_f1 && cmp.fscore_at(0.005)->fscore >= min_f05;
         fprintf(stderr, "%-20s %s orientation %.3f%%  watertight %d  components %zu/%zu  genus %s/%s", name.c_str(),
                 ok ? "ok  " : "FAIL", 100 * orientation, int(check.watertight), check.components, expected_components,
                 join(genus).c_str(), scored ? join(expected_genus).c_str() : "?");

@@ -32,6 +32,7 @@ struct Expectation {
     double min_orientation;  // share of points with outward normals
     double max_mean_distance;  // mesh → true surface, fraction of the bbox diagonal
     double max_gap;            // true surface → mesh, worst case, fraction of the diagonal
+    double max_distance = 1.0; // mesh → true surface, worst case, fraction of the diagonal
 };
 
 double diagonal(const AnalyticShape &s) { return s.bounds().diagonal().norm(); }
@@ -53,11 +54,13 @@ Reconstruction check_shape(const AnalyticShape &shape, size_t count, const Expec
     OrientationScore o = orientation_accuracy(r.normals, pts.normals);
     ShapeDeviation d = compare_to_shape(r.mesh, shape, 20000, 3);
     const double diag = diagonal(shape);
-    fprintf(stderr, "  orientation %.4f%%, mean distance %.5f%%, max gap %.4f%% of the diagonal, %zu triangles\n",
-            100 * o.accuracy, 100 * d.mean_distance / diag, 100 * d.max_gap / diag, r.mesh.triangles.size());
+    fprintf(stderr, "  orientation %.4f%%, mean distance %.5f%%, max distance %.4f%%, max gap %.4f%% of the diagonal, %zu triangles\n",
+            100 * o.accuracy, 100 * d.mean_distance / diag, 100 * d.max_distance / diag, 100 * d.max_gap / diag,
+            r.mesh.triangles.size());
     assert_true(o.accuracy >= e.min_orientation);
     assert_true(d.mean_distance <= e.max_mean_distance * diag);
     assert_true(d.max_gap <= e.max_gap * diag);
+    assert_true(d.max_distance <= e.max_distance * diag);
     assert_true(d.normal_agreement > 0.98);
     assert_true(d.inward_share < 0.005);
     // Outward winding: the enclosed volume is positive and close to the solid's.
@@ -118,6 +121,16 @@ void thin_plate(void **) {
     Plate shape({0, 0, 0}, {1.0, 1.0, 0.04});
     Reconstruction r = check_shape(shape, 40000, {1, 0, 0.995, 0.001, 0.01});
     check_signs(r, shape, {{0, 0, 0}, {0.5, -0.5, 0.01}, {0, 0, 0.1}, {0, 0, -0.1}, {0.9, 0.9, 0}});
+}
+
+void cube(void **) {
+    // Sharp edges and corners. Beside a corner, coarse cells with no point in their cube
+    // fit the two or three faces with one quadric that misses ε by far; at full weight they
+    // pulled the blend into pockets inside the solid (mean distance 0.039 % here, 0.010 %
+    // with them down-weighted; build_octree.cpp).
+    Plate shape({0.1, 0, -0.2}, {0.5, 0.5, 0.5});
+    Reconstruction r = check_shape(shape, 30000, {1, 0, 0.999, 0.0002, 0.01, 0.006});
+    check_signs(r, shape, {{0.1, 0, -0.2}, {0.55, 0.45, 0.25}, {0.7, 0.6, 0.4}, {-0.45, 0, -0.2}});
 }
 
 void islands(void **) {
@@ -214,6 +227,7 @@ int main(void) {
         cmocka_unit_test(torus),
         cmocka_unit_test(nested_spheres),
         cmocka_unit_test(thin_plate),
+        cmocka_unit_test(cube),
         cmocka_unit_test(islands),
         cmocka_unit_test(scale_invariance),
         cmocka_unit_test(input_normals_decide_the_sign),
