@@ -41,32 +41,35 @@ double SurfaceField::far_value(const Eigen::Vector3d &x, Eigen::Vector3d *gradie
         if (gradient) *gradient = -x.normalized();
         return -x.norm();
     }
-    // Hoppe's side test, voted over the k nearest points (weighted by closeness) so that
-    // one poorly estimated normal — at the tip of a thin part, say — cannot flip a region.
-    thread_local std::vector<uint32_t> idx;
-    thread_local std::vector<float> d2;
-    points_.nearest(x, kSideVotes, idx, d2, reach_);
-    if (idx.empty()) {
-        if (gradient) gradient->setZero();
-        return -reach_;  // beyond the reach of every point: outside
-    }
-    double vote = 0.0;
-    for (size_t k = 0; k < idx.size(); ++k) {
-        const uint32_t i = idx[k];
-        Eigen::Vector3d n(measures_.normals[3 * i], measures_.normals[3 * i + 1], measures_.normals[3 * i + 2]);
-        double side = (x - points_.point(i)).dot(n);
-        vote += (side < 0.0 ? 1.0 : -1.0) / (std::sqrt(double(d2[k])) + 1e-12);
-    }
-    double sign = vote > 0.0 ? 1.0 : -1.0;  // behind the outward normals: inside
-    const double distance = std::sqrt(double(d2[0]));
-    // The side test only sees the nearest points: far beyond a concave part (above a back
-    // between two humps, say) their normals can all face away from x and call it inside.
-    // The winding number sums every point; where it is clearly 0 or 1, it decides.
+    // The sign: the winding number of all the oriented points where it is clearly 0 or 1;
+    // else Hoppe's side test, voted over the k nearest points (weighted by closeness) so
+    // that one poorly estimated normal (at the tip of a thin part, say) cannot flip a
+    // region. The side test alone only sees the nearest points: far beyond a concave part
+    // (above a back between two humps, say) their normals can all face away from x.
+    double sign = 0.0;
     if (winding_ && !winding_->empty()) {
         const double w = winding_->winding(x, kWindingFarRatio);
         if (w > 1.0 - kDecisiveWinding) sign = 1.0;
         else if (w < kDecisiveWinding) sign = -1.0;
     }
+    thread_local std::vector<uint32_t> idx;
+    thread_local std::vector<float> d2;
+    points_.nearest(x, sign != 0.0 ? 1 : kSideVotes, idx, d2, reach_);
+    if (idx.empty()) {
+        if (gradient) gradient->setZero();
+        return -reach_;  // beyond the reach of every point: outside
+    }
+    if (sign == 0.0) {
+        double vote = 0.0;
+        for (size_t k = 0; k < idx.size(); ++k) {
+            const uint32_t i = idx[k];
+            Eigen::Vector3d n(measures_.normals[3 * i], measures_.normals[3 * i + 1], measures_.normals[3 * i + 2]);
+            double side = (x - points_.point(i)).dot(n);
+            vote += (side < 0.0 ? 1.0 : -1.0) / (std::sqrt(double(d2[k])) + 1e-12);
+        }
+        sign = vote > 0.0 ? 1.0 : -1.0;  // behind the outward normals: inside
+    }
+    const double distance = std::sqrt(double(d2[0]));
     if (gradient) {
         Eigen::Vector3d away = x - points_.point(idx[0]);
         // f = sign · distance grows away from the point inside and falls outside.

@@ -12,6 +12,7 @@ Run as a script, this file is the Open3D child:
 import json
 import os
 import re
+import resource
 import signal
 import subprocess
 import sys
@@ -25,6 +26,10 @@ HERE = Path(__file__).resolve().parent
 
 # Open3D: neighbours for PCA normals and for the tangent-plane MST (its docs use 30 / k).
 OPEN3D_KNN = 30
+# Every run may use at most this much memory (RLIMIT_DATA: heap and anonymous mappings).
+# CGAL's pipeline once grew past 17 GB on a 5k-point cloud (fandisk_sparse5k) and would
+# have taken the 24 GB machine with it; capped, it fails like any other allocation failure.
+MEMORY_CAP_GB = 12
 
 
 @dataclass
@@ -41,6 +46,11 @@ class Run:
     error: str = ""
 
 
+def cap_memory():
+    limit = MEMORY_CAP_GB << 30
+    resource.setrlimit(resource.RLIMIT_DATA, (limit, limit))
+
+
 def run_child(cmd, timeout, log_path):
     """Runs cmd; returns (exit code, negative for a signal, or None on timeout; wall seconds;
     peak RSS in MB; stdout). stderr goes to log_path.
@@ -52,7 +62,7 @@ def run_child(cmd, timeout, log_path):
     start = time.perf_counter()
     with open(out_path, "w") as out, open(log_path, "w") as log:
         proc = subprocess.Popen([TIME, "-f", "%M", "-o", str(rss_path), *cmd], stdout=out,
-                                stderr=log, start_new_session=True)
+                                stderr=log, start_new_session=True, preexec_fn=cap_memory)
         try:
             proc.wait(timeout=timeout)
         except subprocess.TimeoutExpired:
@@ -95,7 +105,7 @@ class Pipeline:
         if code is None:
             run.error = f"timed out after {timeout:.0f} s"
         elif code < 0:
-            run.error = f"crashed ({signal.Signals(-code).name})"
+            run.error = f"crashed ({signal.Signals(-code).name}; runs are capped at {MEMORY_CAP_GB} GB)"
         elif code != 0:
             run.error = (log_text.strip().splitlines() or [f"exit {code}"])[-1][:300]
         elif not mesh.exists() or not points.exists():
