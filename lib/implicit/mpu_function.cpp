@@ -77,7 +77,8 @@ double MpuFunction::value(const Eigen::Vector3d &x, Eigen::Vector3d *gradient) c
 
 void MpuFunction::gather(const Eigen::AlignedBox3d &box, std::vector<uint32_t> &leaves) const {
     leaves.clear();
-    std::vector<uint32_t> stack{0};
+    thread_local std::vector<uint32_t> stack;
+    stack.assign(1, 0);
     while (!stack.empty()) {
         const uint32_t i = stack.back();
         stack.pop_back();
@@ -94,6 +95,15 @@ void MpuFunction::gather(const Eigen::AlignedBox3d &box, std::vector<uint32_t> &
         }
     }
     std::sort(leaves.begin(), leaves.end());
+}
+
+void MpuFunction::gather_among(const std::vector<uint32_t> &candidates, const Eigen::AlignedBox3d &box,
+                               std::vector<uint32_t> &leaves) const {
+    leaves.clear();
+    for (uint32_t i : candidates) {
+        const Cell &c = tree_.cells[i];
+        if (box.squaredExteriorDistance(c.centre) < c.radius * c.radius) leaves.push_back(i);
+    }
 }
 
 double MpuFunction::value_among(const std::vector<uint32_t> &leaves, const Eigen::Vector3d &x,

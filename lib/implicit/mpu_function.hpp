@@ -32,6 +32,10 @@ public:
 
     // The leaves (at the level cap) whose support meets `box`, in increasing index.
     void gather(const Eigen::AlignedBox3d &box, std::vector<uint32_t> &leaves) const;
+    // The same for a box inside the one `candidates` was gathered for: a filter of that
+    // list, without walking the octree again.
+    void gather_among(const std::vector<uint32_t> &candidates, const Eigen::AlignedBox3d &box,
+                      std::vector<uint32_t> &leaves) const;
 
     // value() for an x inside the box `leaves` was gathered for: same result, faster.
     double value_among(const std::vector<uint32_t> &leaves, const Eigen::Vector3d &x,

@@ -43,12 +43,17 @@ struct SubBlockLeaves {
     static constexpr int S = B / 2;
     std::vector<uint32_t> list[8];
     void gather(const MpuFunction &mpu, const BlockGrid &g, const int64_t origin[3]) {
+        // A hair wider than each sub-block, so a vertex rounded just past its face still
+        // finds every leaf that covers it (an extra candidate changes nothing).
+        const Eigen::Vector3d pad = Eigen::Vector3d::Constant(1e-6 * g.h);
+        // One octree walk for the whole block; each sub-block filters its list.
+        thread_local std::vector<uint32_t> block;
+        const Eigen::Vector3d origin_corner = g.corner(origin[0], origin[1], origin[2]);
+        mpu.gather(Eigen::AlignedBox3d(origin_corner - pad, origin_corner + Eigen::Vector3d::Constant(2 * S * g.h) + pad),
+                   block);
         for (int s = 0; s < 8; ++s) {
             const Eigen::Vector3d lo = g.corner(origin[0] + S * (s & 1), origin[1] + S * (s >> 1 & 1), origin[2] + S * (s >> 2 & 1));
-            // A hair wider than the sub-block, so a vertex rounded just past its face still
-            // finds every leaf that covers it (an extra candidate changes nothing).
-            const Eigen::Vector3d pad = Eigen::Vector3d::Constant(1e-6 * g.h);
-            mpu.gather(Eigen::AlignedBox3d(lo - pad, lo + Eigen::Vector3d::Constant(S * g.h) + pad), list[s]);
+            mpu.gather_among(block, Eigen::AlignedBox3d(lo - pad, lo + Eigen::Vector3d::Constant(S * g.h) + pad), list[s]);
         }
     }
     // For a corner (0..B per axis) or a cube (0..B-1): a sub-block whose box holds it.
