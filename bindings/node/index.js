@@ -406,18 +406,7 @@ export class Surface {
      * apply to this call only (the surface's parameters are restored afterwards).
      */
     polygonize(options = {}) {
-        const out = [null];
-        const saved = this.#overrideForPolygonize(options);
-        try {
-            this.#stage((h) => lib().surface_polygonize(h, out));
-        } catch (err) {
-            // The stage may have completed while onProgress threw at its very end.
-            if (out[0] !== null) lib().mesh_destroy(out[0]);
-            throw err;
-        } finally {
-            this.#restoreParams(saved);
-        }
-        return takeMesh(out[0]);
+        return this.#polygonizeWith(options, (out) => this.#stage((h) => lib().surface_polygonize(h, out)));
     }
 
     // ---- the same stages without blocking the event loop ----
@@ -443,17 +432,32 @@ export class Surface {
     async polygonizeAsync(options = {}) {
         const { signal, ...overrides } = options ?? {};
         signalOf({ signal });
+        return this.#polygonizeWith(overrides, (out) => this.#stageAsync('surface_polygonize', [out], signal));
+    }
+
+    // Polygonize with per-call parameters, restored afterwards. run(out) runs the stage
+    // (returning nothing, or a promise for the async stage); the mesh it leaves in out[0]
+    // is copied out and freed. A mesh completed while onProgress threw at the stage's very
+    // end is freed too.
+    #polygonizeWith(overrides, run) {
         const out = [null];
         const saved = this.#overrideForPolygonize(overrides);
-        try {
-            await this.#stageAsync('surface_polygonize', [out], signal);
-        } catch (err) {
-            if (out[0] !== null) lib().mesh_destroy(out[0]);
-            throw err;
-        } finally {
+        const done = () => {
             this.#restoreParams(saved);
+            return takeMesh(out[0]);
+        };
+        const failed = (err) => {
+            if (out[0] !== null) lib().mesh_destroy(out[0]);
+            this.#restoreParams(saved);
+            throw err;
+        };
+        let pending;
+        try {
+            pending = run(out);
+        } catch (err) {
+            failed(err);
         }
-        return takeMesh(out[0]);
+        return pending instanceof Promise ? pending.then(done, failed) : done();
     }
 
     // Sets polygonize's per-call parameters; returns the values to restore.
