@@ -240,7 +240,7 @@ def full(args, metrics_exe, build):
 
     bunny = next((c for c in clouds if c.name == "bunny_clean"), None)
     if bunny and any(p.name == "gmpu" for p in chosen):
-        results["binding"] = binding_cost.measure(build, bunny.path, pairs=15)
+        results["binding"] = binding_cost.measure(build, bunny.path, pairs=21)
         print(binding_cost.summary(results["binding"]), flush=True)
         save(results, args.out)
 
