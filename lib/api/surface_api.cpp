@@ -393,7 +393,7 @@ GMPU_API gmpu_status gmpu_surface_evaluate(const gmpu_surface *s, const double *
             if (!std::isfinite(xyz[i]))
                 throw Error(GMPU_ERROR_INVALID_INPUT, "query point " + std::to_string(i / 3) + " is NaN or infinite");
         const gmpu::MpuFunction mpu(s->tree, s->params.level);
-        const gmpu::SurfaceField f(mpu, s->points, s->measures, 0.0, INFINITY, &s->winding);
+        const gmpu::SurfaceField f(mpu, s->points, s->measures, s->winding);
         const gmpu::Normalisation &norm = s->points.normalisation();
         Eigen::Vector3d g;
         for (size_t i = 0; i < count; ++i) {

@@ -7,7 +7,7 @@
 // spacings, never less than two polygonizer cubes); there f is the MPU blend. Farther out
 // f = ±d(x), the distance to the nearest point, signed by which side of the nearby points'
 // oriented normals x lies on (Hoppe's test, voted over the 8 nearest points), unless the
-// winding number, when given, is clearly 0 or 1 there (it sees every point, and the
+// winding number is clearly 0 or 1 there (it sees every point, and the
 // nearest ones can all face away from x beyond a concave part): continuous
 // enough at the border (the blend is about a signed distance too) and never zero, so no
 // surface can appear away from the data.
@@ -39,11 +39,11 @@ public:
     // bounds the neighbour searches of untrusted queries (infinite for general use; the
     // polygonizer knows every query it makes has a point within its band's reach, and
     // bounded searches are much cheaper far from the data).
-    // `winding` (optional) overrules the far field's side test where the winding number is
-    // decisive (see far_value).
+    // `winding` (built from the same measures) signs the far field where it is decisive
+    // (see far_value); an empty one leaves it to the side test.
     SurfaceField(const MpuFunction &mpu, const PointSet &points, const PointMeasures &measures,
-                 double min_trust = 0.0, double reach = INFINITY, const WindingField *winding = nullptr)
-        : mpu_(mpu), points_(points), measures_(measures), min_trust_(min_trust), reach_(reach), winding_(winding) {}
+                 const WindingField &winding, double min_trust = 0.0, double reach = INFINITY)
+        : mpu_(mpu), points_(points), measures_(measures), winding_(winding), min_trust_(min_trust), reach_(reach) {}
 
     // f and optionally ∇f at x (normalised frame).
     double value(const Eigen::Vector3d &x, Eigen::Vector3d *gradient) const;
@@ -67,8 +67,8 @@ private:
     const MpuFunction &mpu_;
     const PointSet &points_;
     const PointMeasures &measures_;
+    const WindingField &winding_;
     double min_trust_, reach_;
-    const WindingField *winding_;
 };
 
 // Area and trust radius of every point, from its k-th neighbour distance (normals are

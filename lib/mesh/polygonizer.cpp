@@ -268,7 +268,7 @@ Mesh polygonize(const MpuFunction &mpu, const WindingField &winding, const Point
     // A band block meets some point's reach, so each of its corners has a point within that
     // reach plus the block's diagonal: the bound for every neighbour search below.
     const double reach = std::max(measures.widest_trust, min_trust) + B * std::sqrt(3.0) * h + h;
-    const SurfaceField f(mpu, points, measures, min_trust, reach, &winding);
+    const SurfaceField f(mpu, points, measures, winding, min_trust, reach);
     std::vector<int64_t> band;
     for (int64_t b = 0; b < int64_t(g.block_count()); ++b)
         if (g.band[size_t(b)]) band.push_back(b);
