@@ -126,6 +126,35 @@ def summary_table(rows):
     return head + "\n".join(lines) + "\n"
 
 
+def per_cloud_table(rows):
+    """Per cloud: gmpu's figures beside the best any peer reached on each (not necessarily
+    the same peer for every column), and gmpu's mesh topology."""
+    head = ("| cloud | points | orientation (best peer) | Chamfer-L1 (best peer) | F@0.5% (best peer) "
+            "| watertight | components | genus | time s (fastest peer) |\n"
+            "|---|---:|---:|---:|---:|:---:|---:|---:|---:|\n")
+    lines = []
+    for cloud, runs in by_cloud(rows).items():
+        g = runs.get("gmpu")
+        if not g:
+            continue
+        peers = [runs[p] for p in PEERS if p in runs and runs[p]["ok"]]
+
+        def best(key, spec, pick=max):
+            vals = [r[key] for r in peers if r.get(key) is not None]
+            return f"{fmt(g.get(key), spec)} ({fmt(pick(vals), spec) if vals else '–'})"
+        if not g["ok"]:
+            lines.append(f"| {cloud} | {g['points']} | failed: {g['error'][:80]} | | | | | | |")
+            continue
+        fastest = min((r["compute"] for r in peers), default=None)
+        lines.append(
+            f"| {cloud} | {g['points']:,} | {best('orientation_accuracy', '.3%')} "
+            f"| {best('chamfer_l1', '.3%', min)} | {best('fscore_0.5', '.4f')} "
+            f"| {'yes' if g.get('watertight') else 'no'} | {g.get('components', '–')} "
+            f"| {','.join(map(str, g.get('genus') or [])) or '–'} "
+            f"| {g['compute']:.2f} ({fmt(fastest, '.2f')}) |")
+    return head + "\n".join(lines) + "\n"
+
+
 def scale_table(scale):
     if not scale:
         return "_No scale series in this run._\n"
@@ -315,6 +344,7 @@ def write_all(results, out_dir, renders=True):
         "±30 % on a shared machine); the peers, at seconds to minutes, run once." + load_note(rows + scale) + "\n\n"
         "### Targets (issues 3 and 5)\n\n" + targets(results) + "\n"
         "### Over all clouds\n\n" + summary_table(rows) + "\n"
+        "### Per cloud: gmpu (the best peer)\n\n" + per_cloud_table(rows) + "\n"
         "### Scale series\n\n" + scale_table(scale) + "\n"
         + ("![time vs points](time_vs_points.png) ![memory vs points](memory_vs_points.png)\n\n"
            if scale else "")
