@@ -114,7 +114,7 @@ def summary(r):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("cloud", nargs="?", type=Path,
-                    default=ROOT.parent / "shared" / "data" / "clouds" / "bunny_clean.ply")
+                    default=ROOT / "tests" / "data" / "clouds" / "bunny_clean.ply")
     ap.add_argument("--build", type=Path, default=ROOT / "build")
     ap.add_argument("--pairs", type=int, default=21)
     args = ap.parse_args()

@@ -10,7 +10,7 @@
 //
 //   gmpu-metrics --sample GT.off --n 35000 --seed 1 [--noise 0.0025] [--nonuniform]
 //                [--sparse] -o CLOUD.ply --gt-out CLOUD_gt.ply
-//       draws a cloud from GT the way /work/shared/data/clouds was made: CLOUD.ply has
+//       draws a cloud from GT the way tests/data/clouds was made: CLOUD.ply has
 //       positions only, CLOUD_gt.ply the same points with the ground-truth outward
 //       normals; prints the metadata as JSON.
 //

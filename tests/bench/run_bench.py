@@ -2,7 +2,7 @@
 """gmpu's benchmark (issue 5): gmpu and its peers (Open3D, CGAL) run side by side on the
 same clouds, in the same run, and are scored by the same exact metrics (gmpu-metrics).
 
-    make bench          every cloud in ../shared/data/clouds, clouds sampled here from every
+    make bench          every cloud in tests/data/clouds, clouds sampled here from every
                         ground-truth mesh, a 10k → 1M scale series; table, plots, pictures
     make bench-quick    gmpu alone on two clouds; exits 1 when a quality floor is missed
                         (and prints what the Python binding costs against the CLI)
@@ -26,7 +26,7 @@ import binding_cost  # noqa: E402
 import pipelines  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[2]
-SHARED = ROOT.parent / "shared" / "data"
+SHARED = ROOT / "tests" / "data"
 
 # Variants sampled from every ground-truth mesh (seeded), the way the shared clouds were
 # made; a variant the shared clouds already have for that mesh is not made again.

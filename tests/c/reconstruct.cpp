@@ -59,9 +59,9 @@ double Reconstruction::stat(gmpu_stat key) const {
     return v;
 }
 
-std::string shared_data(const std::string &relative) {
-    const char *env = std::getenv("GMPU_SHARED_DATA");
-    std::string root = env ? env : std::string(std::getenv("GMPU_SOURCE_ROOT") ? std::getenv("GMPU_SOURCE_ROOT") : ".") + "/../shared/data";
+std::string test_data(const std::string &relative) {
+    const char *env = std::getenv("GMPU_TEST_DATA");
+    std::string root = env ? env : std::string(std::getenv("GMPU_SOURCE_ROOT") ? std::getenv("GMPU_SOURCE_ROOT") : ".") + "/tests/data";
     return root + "/" + relative;
 }
 

@@ -42,7 +42,7 @@ Reconstruction reconstruct(const std::vector<Vec3> &points,
                            const std::vector<std::pair<gmpu_param, double>> &params = {},
                            const std::vector<Vec3> *input_normals = nullptr);
 
-// $GMPU_SHARED_DATA (set by meson) or ../shared/data from the source root.
-std::string shared_data(const std::string &relative);
+// $GMPU_TEST_DATA (set by meson) or tests/data from the source root.
+std::string test_data(const std::string &relative);
 
 }  // namespace gmpu::testing

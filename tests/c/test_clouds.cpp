@@ -1,4 +1,4 @@
-// The shared data's clouds (../shared/data/clouds, every one found there): the issue's
+// The repository's clouds (tests/data/clouds, every one found there): the issue's
 // acceptance numbers, asserted. Orientation accuracy against the ground-truth outward
 // normals (no global flip allowed), a watertight mesh with one component per connected
 // shape (as many as the ground-truth mesh has, each of the same genus), and exact distances
@@ -70,7 +70,7 @@ std::string join(const std::vector<int> &v) {
 
 std::vector<std::string> cloud_names() {
     std::vector<std::string> names;
-    DIR *dir = opendir(shared_data("clouds").c_str());
+    DIR *dir = opendir(test_data("clouds").c_str());
     if (!dir) return names;
     while (dirent *e = readdir(dir)) {
         std::string f = e->d_name;
@@ -85,14 +85,14 @@ std::vector<std::string> cloud_names() {
 
 void every_cloud(void **) {
     const std::vector<std::string> names = cloud_names();
-    if (names.empty()) fprintf(stderr, "no clouds under %s\n", shared_data("clouds").c_str());
-    assert_true(names.size() >= 10);  // the shared data's README lists ten
+    if (names.empty()) fprintf(stderr, "no clouds under %s\n", test_data("clouds").c_str());
+    assert_true(names.size() >= 10);  // tests/data/README.md lists ten
     int failures = 0;
     for (const std::string &name : names) {
-        const Meta meta = read_meta(shared_data("clouds/" + name + "_meta.json"));
+        const Meta meta = read_meta(test_data("clouds/" + name + "_meta.json"));
         const bool noisy = meta.noise > 0;
-        OrientedPoints cloud = load_points(shared_data("clouds/" + name + ".ply"));
-        OrientedPoints gt = load_points(shared_data("clouds/" + name + "_gt.ply"));
+        OrientedPoints cloud = load_points(test_data("clouds/" + name + ".ply"));
+        OrientedPoints gt = load_points(test_data("clouds/" + name + "_gt.ply"));
         Reconstruction r = reconstruct(cloud.positions);
         if (r.status != GMPU_OK) {
             fprintf(stderr, "%-20s FAILED: %s\n", name.c_str(), r.error.c_str());
@@ -108,7 +108,7 @@ void every_cloud(void **) {
         SurfaceComparison cmp;
         const bool scored = meta.present && !meta.mesh.empty();
         if (scored) {
-            TriangleMesh truth = load_mesh(shared_data("meshes/" + meta.mesh));
+            TriangleMesh truth = load_mesh(test_data("meshes/" + meta.mesh));
             const MeshCheck truth_check = check_mesh(truth);
             expected_components = truth_check.components;
             for (const auto &c : truth_check.component_reports) expected_genus.push_back(c.genus);

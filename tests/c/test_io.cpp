@@ -706,8 +706,8 @@ void test_buffer_parsers(void **) {
 // ---- the shared data sets -------------------------------------------------------------
 
 std::string shared(const std::string &rel) {
-    const char *root = std::getenv("GMPU_SHARED_DATA");
-    return std::string(root ? root : "../shared/data") + "/" + rel;
+    const char *root = std::getenv("GMPU_TEST_DATA");
+    return std::string(root ? root : "tests/data") + "/" + rel;
 }
 
 void test_shared_clouds(void **) {

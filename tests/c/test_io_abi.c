@@ -237,29 +237,29 @@ static void test_mesh_write(void **state) {
     gmpu_mesh_destroy(m);
 }
 
-static void test_shared_data(void **state) {
+static void test_repository_data(void **state) {
     (void)state;
-    const char *root = getenv("GMPU_SHARED_DATA");
+    const char *root = getenv("GMPU_TEST_DATA");
     char path[512];
     gmpu_points *p = NULL;
-    snprintf(path, sizeof path, "%s/clouds/bunny_clean.ply", root ? root : "../shared/data");
+    snprintf(path, sizeof path, "%s/clouds/bunny_clean.ply", root ? root : "tests/data");
     assert_int_equal(gmpu_points_read(path, &p), GMPU_OK);
     assert_int_equal(gmpu_points_count(p), 35000);
     assert_null(gmpu_points_normals(p));
     gmpu_points_destroy(p);
-    snprintf(path, sizeof path, "%s/clouds/bunny_clean_gt.ply", root ? root : "../shared/data");
+    snprintf(path, sizeof path, "%s/clouds/bunny_clean_gt.ply", root ? root : "tests/data");
     assert_int_equal(gmpu_points_read(path, &p), GMPU_OK);
     assert_int_equal(gmpu_points_count(p), 35000);
     const double *n = gmpu_points_normals(p);
     assert_non_null(n);
     assert_true(fabs(n[0] * n[0] + n[1] * n[1] + n[2] * n[2] - 1) < 1e-4);
     gmpu_points_destroy(p);
-    snprintf(path, sizeof path, "%s/scans/kitten.xyz", root ? root : "../shared/data");
+    snprintf(path, sizeof path, "%s/scans/kitten.xyz", root ? root : "tests/data");
     assert_int_equal(gmpu_points_read(path, &p), GMPU_OK);
     assert_int_equal(gmpu_points_count(p), 5210);
     assert_non_null(gmpu_points_normals(p));
     gmpu_points_destroy(p);
-    snprintf(path, sizeof path, "%s/meshes/bunny00.off", root ? root : "../shared/data");
+    snprintf(path, sizeof path, "%s/meshes/bunny00.off", root ? root : "tests/data");
     assert_int_equal(gmpu_points_read(path, &p), GMPU_OK);
     assert_int_equal(gmpu_points_count(p), 37706);
     gmpu_points_destroy(p);
@@ -275,7 +275,7 @@ int main(void) {
         cmocka_unit_test(test_mesh_create_and_access),
         cmocka_unit_test(test_mesh_create_errors),
         cmocka_unit_test(test_mesh_write),
-        cmocka_unit_test(test_shared_data),
+        cmocka_unit_test(test_repository_data),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -226,18 +226,18 @@ def self_test() -> None:
 
 # ---- the programs --------------------------------------------------------------------------
 
-def shared_data() -> str:
-    d = os.environ.get("GMPU_SHARED_DATA") or os.path.join(ROOT, "..", "shared", "data")
+def test_data() -> str:
+    d = os.environ.get("GMPU_TEST_DATA") or os.path.join(ROOT, "tests", "data")
     return os.path.abspath(d)
 
 
 def inputs() -> List[Tuple[str, str]]:
     clouds = [("bunny", os.path.join(ROOT, "examples", "data", "bunny.ply")),
-              ("knot_clean", os.path.join(shared_data(), "clouds", "knot_clean.ply"))]
+              ("knot_clean", os.path.join(test_data(), "clouds", "knot_clean.ply"))]
     for name, path in clouds:
         if not os.path.isfile(path):
             raise SystemExit(f"cross_language: input {name} not found at {path} "
-                             "(set GMPU_SHARED_DATA to the shared data directory)")
+                             "(tests/data ships with the repository; GMPU_TEST_DATA overrides it)")
     return clouds
 
 

@@ -13,12 +13,12 @@ export const examplesDir = path.join(repoRoot, 'examples', 'node');
 export const samplePly = path.join(repoRoot, 'examples', 'data', 'bunny.ply');
 export const cliPath = path.join(repoRoot, 'build', 'examples', 'gmpu-reconstruct');
 
-/** The shared data directory: $GMPU_SHARED_DATA, or ../shared/data beside the repo. Fails loudly if absent. */
-export function sharedData() {
-    const dir = process.env.GMPU_SHARED_DATA || path.resolve(repoRoot, '..', 'shared', 'data');
+/** The test data directory: $GMPU_TEST_DATA, or tests/data of this checkout. Fails loudly if absent. */
+export function testData() {
+    const dir = process.env.GMPU_TEST_DATA || path.resolve(repoRoot, 'tests', 'data');
     assert.ok(
         fs.existsSync(path.join(dir, 'clouds')),
-        `shared test data not found at ${dir} (clone the repo beside shared/, or set GMPU_SHARED_DATA)`,
+        `test data not found at ${dir} (it ships in tests/data; GMPU_TEST_DATA overrides it)`,
     );
     return dir;
 }

@@ -2,8 +2,7 @@
 
 Run with `make test-python` (or `/usr/bin/python3 -m pytest tests/python`). The binding is
 imported from bindings/python of this checkout and loads build/lib/libgmpu.so.1 unless
-GMPU_LIBRARY says otherwise. Test data: $GMPU_SHARED_DATA, else ../shared/data beside the
-repository (CI clones the repository next to shared/).
+GMPU_LIBRARY says otherwise. Test data: $GMPU_TEST_DATA, else tests/data of this checkout.
 """
 import os
 import subprocess
@@ -25,16 +24,16 @@ CLI = REPO / "build" / "examples" / "gmpu-reconstruct"
 SAMPLE = REPO / "examples" / "data" / "bunny.ply"
 
 
-def shared_data_dir() -> Path:
-    env = os.environ.get("GMPU_SHARED_DATA")
-    return Path(env) if env else REPO.parent / "shared" / "data"
+def repository_data_dir() -> Path:
+    env = os.environ.get("GMPU_TEST_DATA")
+    return Path(env) if env else REPO / "tests" / "data"
 
 
 @pytest.fixture(scope="session")
 def data_dir() -> Path:
-    d = shared_data_dir()
+    d = repository_data_dir()
     if not (d / "clouds").is_dir():
-        pytest.fail(f"test data not found: {d}/clouds (clone shared/ beside the repository or set GMPU_SHARED_DATA)")
+        pytest.fail(f"test data not found: {d}/clouds (it ships with the repository; GMPU_TEST_DATA overrides it)")
     return d
 
 

@@ -29,7 +29,7 @@ fn bunny_sample_is_watertight_outward_and_correctly_oriented() {
     assert!(s.stat(Stat::Leaves).unwrap() > 100.0);
 
     // Per-point normals against the ground truth of the same points (bunny_clean).
-    let gt = Points::read(shared_data().join("clouds/bunny_clean_gt.ply")).unwrap();
+    let gt = Points::read(test_data().join("clouds/bunny_clean_gt.ply")).unwrap();
     assert_eq!(gt.positions(), cloud.positions(), "bunny.ply is bunny_clean.ply");
     let normals = s.normals().unwrap();
     assert_eq!(normals.len(), 35_000);
@@ -135,7 +135,7 @@ fn f32_strided_and_packed_inputs_agree() {
 
 #[test]
 fn input_normals_drive_the_orientation() {
-    let cloud = Points::read(shared_data().join("clouds/elephant_sparse5k_gt.ply")).unwrap();
+    let cloud = Points::read(test_data().join("clouds/elephant_sparse5k_gt.ply")).unwrap();
     let truth = cloud.normals().unwrap();
     let mut s = Surface::new().unwrap();
     s.set_param(Param::Threads, 2.0).unwrap();

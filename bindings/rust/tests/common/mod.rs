@@ -12,14 +12,14 @@ pub fn sample() -> PathBuf {
     repo_root().join("examples/data/bunny.ply")
 }
 
-/// The shared data directory: GMPU_SHARED_DATA, else `../shared/data` beside the repository.
+/// The test data directory: GMPU_TEST_DATA, else `tests/data` of this checkout.
 /// Missing data is a failure, not a skip.
-pub fn shared_data() -> PathBuf {
-    let dir = match std::env::var_os("GMPU_SHARED_DATA") {
+pub fn test_data() -> PathBuf {
+    let dir = match std::env::var_os("GMPU_TEST_DATA") {
         Some(d) => PathBuf::from(d),
-        None => repo_root().join("../shared/data"),
+        None => repo_root().join("tests/data"),
     };
-    assert!(dir.join("clouds").is_dir(), "shared test data not found at {} (set GMPU_SHARED_DATA)", dir.display());
+    assert!(dir.join("clouds").is_dir(), "test data not found at {} (set GMPU_TEST_DATA)", dir.display());
     dir
 }
 
