@@ -6,7 +6,7 @@ import path from 'node:path';
 import { test } from 'node:test';
 
 import {
-    assertWatertight, orientationAccuracy, packageUrl, readPly, runCli, samplePly, sharedData, spherePoints, tempDir, torusPoints,
+    assertWatertight, orientationAccuracy, packageUrl, readPly, runCli, samplePly, testData, spherePoints, tempDir, torusPoints,
 } from './helpers.mjs';
 
 const gmpu = await import(packageUrl);
@@ -47,7 +47,7 @@ test('sample: the Node mesh equals the C CLI mesh bit for bit, and is watertight
 });
 
 test('bunny_clean: oriented normals agree with the ground truth on at least 99.5% of points', () => {
-    const clouds = path.join(sharedData(), 'clouds');
+    const clouds = path.join(testData(), 'clouds');
     const cloud = gmpu.readPoints(path.join(clouds, 'bunny_clean.ply'));
     const gt = gmpu.readPoints(path.join(clouds, 'bunny_clean_gt.ply'));
     assert.ok(gt.normals, 'ground truth has normals');
