@@ -83,6 +83,15 @@ test-cross: build
 	  (cd $$d && npm ci --no-audit --no-fund --loglevel=error) || exit 1; done
 	$(PYTHON) tests/cross/cross_language.py --build $(BUILD)
 
+# The progress cadence and cancel latency are promised in CPU time, so they must hold on a
+# busy machine: the cancel suite and the Python progress tests beside two busy loops. (The
+# Ctrl-C tests are left out: they time a signal in wall time, which the busy loops delay.)
+.PHONY: test-load
+test-load: build
+	tests/load/with_busy_cores.sh meson test -C $(BUILD) --no-rebuild --print-errorlogs cancel
+	tests/load/with_busy_cores.sh $(PYTHON) -m pytest tests/python/test_progress.py -q -p no:cacheprovider \
+	  --basetemp=$(BUILD)/pytest-load -k "not ctrl_c"
+
 # ---- robustness (issue 6): sanitizers, valgrind, fuzzing, the hostile corpus -------------
 # build-sanitize: clang, ASan + UBSan (any report aborts), the library also carrying
 # libFuzzer's coverage instrumentation, so that one build serves the C suites, the CLI on

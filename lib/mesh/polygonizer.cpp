@@ -264,7 +264,7 @@ int default_resolution(const Octree &tree) {
 Mesh polygonize(const MpuFunction &mpu, const WindingField &winding, const PointSet &points,
                 const PointMeasures &measures, int resolution, const Params &params, Progress &progress) {
     const double h = 1.0 / resolution, min_trust = 2.0 * h;
-    const BlockGrid g(points, resolution, measures.trust_radius, min_trust, winding);
+    const BlockGrid g(points, resolution, measures.trust_radius, min_trust, winding, progress);
     // A band block meets some point's reach, so each of its corners has a point within that
     // reach plus the block's diagonal: the bound for every neighbour search below.
     const double reach = std::max(measures.widest_trust, min_trust) + B * std::sqrt(3.0) * h + h;
@@ -288,15 +288,14 @@ Mesh polygonize(const MpuFunction &mpu, const WindingField &winding, const Point
                         "the mesh needs more than GMPU_PARAM_MAX_TRIANGLES = " +
                             std::to_string(uint64_t(params.max_triangles)) +
                             " triangles; lower GMPU_PARAM_RESOLUTION or raise the cap");
-    }, 0.02 * total, total, 4);
+    }, 0.02 * total, total, 1);  // one block per chunk: a cancel waits for one block per thread
     progress.throw_if_cancelled();
     progress.report(0.95);
     std::vector<uint32_t> votes;
     Mesh mesh = weld(blocks, points.normalisation(), progress, votes);
     progress.throw_if_cancelled();
-    remove_unsupported_components(mesh, votes, kMinVotes);
-    progress.report(1.0, true);
-    return mesh;
+    remove_unsupported_components(mesh, votes, kMinVotes, progress);
+    return mesh;  // the caller makes the final report, once the temporaries are freed
 }
 
 }  // namespace gmpu

@@ -130,11 +130,12 @@ void robust_taubin_error(void **) {
 }
 
 void noise_estimate_tracks_the_noise(void **) {
+    Progress quiet(nullptr, nullptr, GMPU_STAGE_FIT);
     for (double sigma : {0.0, 0.005, 0.02}) {
         std::vector<double> xyz = flat(sphere_points(30000, 1.0, sigma, 17));
         PointSet ps = PointSet::from_array(xyz.data(), 30000, 0, 15);
         // In normalised units: the sphere's longest side (2) becomes 1.
-        double est = estimate_noise(ps) * 2.0;
+        double est = estimate_noise(ps, quiet) * 2.0;
         fprintf(stderr, "  sigma %.3f estimated %.4f\n", sigma, est);
         if (sigma == 0) assert_true(est < 0.001);
         else assert_true(est > 0.6 * sigma && est < 1.3 * sigma);
@@ -340,8 +341,9 @@ void unsupported_components_are_dropped(void **) {
         m.triangles.insert(m.triangles.end(), {b, b + 2, b + 1, b, b + 1, b + 3, b, b + 3, b + 2, b + 1, b + 2, b + 3});
     }
     std::vector<uint32_t> comp;
-    assert_int_equal(vertex_components(m, comp), 2);
-    remove_unsupported_components(m, {0, 0, 0, 0, 1, 2, 0, 0}, 3);
+    Progress quiet(nullptr, nullptr, GMPU_STAGE_POLYGONIZE);
+    assert_int_equal(vertex_components(m, comp, quiet), 2);
+    remove_unsupported_components(m, {0, 0, 0, 0, 1, 2, 0, 0}, 3, quiet);
     assert_int_equal(m.vertex_count(), 4);
     assert_int_equal(m.triangle_count(), 4);
     assert_near(m.vertices[0], 5.0, 0);
