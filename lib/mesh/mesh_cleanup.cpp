@@ -47,7 +47,10 @@ void remove_unsupported_components(Mesh &mesh, const std::vector<uint32_t> &vote
     if (!any_removed) return;
 
     std::vector<uint32_t> remap(mesh.vertex_count(), UINT32_MAX);
-    Mesh kept;
+    Mesh kept;  // reserved: growing by doubling would copy megabytes between ticks
+    kept.vertices.reserve(mesh.vertices.size());
+    kept.normals.reserve(mesh.normals.size());
+    kept.triangles.reserve(mesh.triangles.size());
     for (size_t v = 0; v < mesh.vertex_count(); ++v) {
         if (v % kTickEvery == 0) progress.tick();
         if (support[component[v]] < min_votes) continue;
