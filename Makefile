@@ -58,7 +58,7 @@ demo: build
 	@echo "Oriented points written to $(abspath $(BUILD)/demo/bunny_oriented_points.ply)"
 
 test: deps-test build
-	$(MAKE) --no-print-directory test-c test-python test-node test-rust test-sanitize test-tsan test-valgrind fuzz-quick
+	$(MAKE) --no-print-directory test-c test-load test-python test-node test-rust test-sanitize test-tsan test-valgrind fuzz-quick
 
 test-c: build
 	meson test -C $(BUILD) --print-errorlogs
@@ -82,6 +82,17 @@ test-cross: build
 	@for d in bindings/node examples/node; do [ -d $$d/node_modules ] || \
 	  (cd $$d && npm ci --no-audit --no-fund --loglevel=error) || exit 1; done
 	$(PYTHON) tests/cross/cross_language.py --build $(BUILD)
+
+# The progress cadence and cancel latency are promised in CPU time, so they must hold on a
+# busy machine: the cancel suite and the Python progress tests beside two busy loops. (The
+# Ctrl-C tests are left out: they time a signal in wall time, which the busy loops delay.)
+# Half test-c's cloud (200k points; test-c runs the suite on 400k unloaded) keeps it near a
+# minute and a half on 2 cores.
+.PHONY: test-load
+test-load: build
+	GMPU_CANCEL_POINTS=200000 tests/load/with_busy_cores.sh meson test -C $(BUILD) --no-rebuild --print-errorlogs cancel
+	tests/load/with_busy_cores.sh $(PYTHON) -m pytest tests/python/test_progress.py -q -p no:cacheprovider \
+	  --basetemp=$(BUILD)/pytest-load -k "not ctrl_c"
 
 # ---- robustness (issue 6): sanitizers, valgrind, fuzzing, the hostile corpus -------------
 # build-sanitize: clang, ASan + UBSan (any report aborts), the library also carrying

@@ -101,44 +101,49 @@ GMPU_API uint32_t gmpu_abi_version(void);        /* GMPU_ABI_VERSION of the libr
 
 /* ---- parameters, stages, statistics -------------------------------------------------- */
 
+/* Each parameter's comment ends with "Default D, range R." (R: "a..b" for integers, "[a, b]"
+ * or "(a, b)" for reals); tests/c/test_docs_match.cpp checks both against the library. */
 typedef enum gmpu_param {
-    /* ε: largest Taubin distance allowed between a cell's points and its local fit, as a
-     * fraction of the bounding-box diagonal. Smaller keeps more detail and costs time.
-     * Default 0.002, range (0, 1). Changing it discards a previous fit. */
+    /* ε: how far a cell's points may lie from its local fit, as a fraction of the
+     * bounding-box diagonal: the 90th percentile of their Taubin distances must be below ε
+     * and the largest below 3ε. Smaller keeps more detail and costs time. Changing it
+     * discards a previous fit. Default 0.002, range (0, 1). */
     GMPU_PARAM_ERROR = 1,
-    /* Deepest octree level (root = 0). Default 10, range 1..16. Discards a previous fit. */
+    /* Deepest octree level (root = 0). Discards a previous fit. Default 10, range 1..16. */
     GMPU_PARAM_MAX_DEPTH = 2,
     /* Fewest points a local fit uses; the support radius grows until it holds them.
-     * Default 15, range 6..1000. Discards a previous fit. */
+     * Discards a previous fit. Default 15, range 6..1000. */
     GMPU_PARAM_MIN_POINTS = 3,
-    /* α: support radius = α × cell diagonal. Default 0.75, range [0.5, 2]. Discards a
-     * previous fit. */
+    /* α: support radius = α × cell diagonal. Discards a previous fit. Default 0.75,
+     * range [0.5, 2]. */
     GMPU_PARAM_SUPPORT_SCALE = 4,
     /* 1: fit piecewise quadrics (min of two or three bivariate quadratics) where a small
      * cell straddles a sharp edge or corner, found by clustering local normals (paper §3.2).
-     * 0 (default): smooth models only — on every cloud we measure, the piecewise fits
-     * needed fewer cells but gave slightly larger distances (the grid polygonizer rounds
-     * edges anyway) and occasionally a false edge; see README. Discards a previous fit. */
+     * 0: smooth models only. Off by default: on the clouds we measure the piecewise fits need
+     * fewer cells and give slightly smaller distances, but the grid polygonizer rounds edges
+     * anyway and they occasionally make a false edge (a handle on the bunny); see README.
+     * Discards a previous fit. Default 0, range 0..1. */
     GMPU_PARAM_SHARP_FEATURES = 5,
     /* Polygonize: grid cubes along the longest side of the points' bounding box.
-     * 0 (default) picks one from the octree (fine enough for the detail the fit has).
-     * Range 0 or 8..4096. */
+     * 0 picks one from the octree (fine enough for the detail the fit has); otherwise at
+     * least 8. Default 0, range 0..4096. */
     GMPU_PARAM_RESOLUTION = 6,
     /* Level of detail: evaluate and polygonize using octree cells down to this level
-     * only (paper Fig. 7). 0 (default) uses every level. Range 0..16. */
+     * only (paper Fig. 7); 0 uses every level. Default 0, range 0..16. */
     GMPU_PARAM_LEVEL = 7,
-    /* Worker threads for fit, orient and polygonize. 0 (default) uses every core. */
+    /* Worker threads for fit, orient and polygonize; 0 uses every core. Default 0,
+     * range 0..1024. */
     GMPU_PARAM_THREADS = 8,
     /* Resource cap: fit fails with GMPU_ERROR_LIMIT_EXCEEDED instead of creating more
-     * octree cells than this. Default 20,000,000 (about 4 GB). Range 1..1e9. */
+     * octree cells than this (the default is about 4 GB). Default 2e7, range 1..1e9. */
     GMPU_PARAM_MAX_CELLS = 9,
     /* Resource cap: polygonize fails with GMPU_ERROR_LIMIT_EXCEEDED instead of making
      * more triangles than this, counted as marching tetrahedra makes them (before closed
-     * pieces that no input point supports are dropped). Default 100,000,000. Range 1..2e9. */
+     * pieces that no input point supports are dropped). Default 1e8, range 1..2e9. */
     GMPU_PARAM_MAX_TRIANGLES = 10,
     /* Noise floor for ε: fit estimates the sampling noise σ̂ and works to
      * max(GMPU_PARAM_ERROR, NOISE_SCALE × σ̂), since fitting below the noise only fits the
-     * noise. Default 2; 0 turns the floor off. Range [0, 20]. Discards a previous fit. */
+     * noise; 0 turns the floor off. Discards a previous fit. Default 2, range [0, 20]. */
     GMPU_PARAM_NOISE_SCALE = 11
 } gmpu_param;
 
@@ -170,9 +175,11 @@ typedef enum gmpu_stat {
 } gmpu_stat;
 
 /* Progress and cancellation. Called on the thread that called fit / orient / polygonize,
- * at least every 50 ms of work, with fraction in [0, 1] (non-decreasing within a stage;
- * 1 when the stage completes). Return 0 to go on; non-zero cancels: the call stops within
- * 100 ms and returns GMPU_ERROR_CANCELLED, and the surface keeps the stages completed
+ * at least every 50 ms of that thread's CPU time (from the call to its return, so a machine
+ * busy with other work stretches the wall-clock interval) and at most every 20 ms, with
+ * fraction in [0, 1] (non-decreasing within a stage; 1 when the stage completes). Return 0
+ * to go on; non-zero cancels: the call stops within 100 ms of work (CPU time of all its
+ * threads) and returns GMPU_ERROR_CANCELLED, and the surface keeps the stages completed
  * before the cancelled one. The callback must not call gmpu functions on the same
  * surface. */
 typedef int (*gmpu_progress_fn)(void *user, gmpu_stage stage, double fraction);
@@ -257,8 +264,10 @@ GMPU_API gmpu_status gmpu_surface_orient(gmpu_surface *surface);
 /* Evaluates the blended implicit f (partition of unity, quadratic B-spline weights) at
  * count points xyz (3 doubles each, packed). values (count doubles) and gradients
  * (3 × count doubles, ∇f) may each be NULL, but not both. f is in the caller's length
- * units (about the signed distance near the surface, positive inside). Far from the data,
- * beyond every leaf's support, f falls back to the coarser fits that cover the point.
+ * units (about the signed distance near the surface, positive inside). Away from the data
+ * (beyond a few point spacings of every input point) f is the distance to the nearest
+ * input point, signed by the winding number of the oriented points where it is clearly 0
+ * or 1 and by the nearby points' normals elsewhere: never zero there, so no surface.
  * Honours GMPU_PARAM_LEVEL. Safe to call from several threads at once after orient.
  * Errors: INVALID_ARGUMENT (NULL), WRONG_ORDER (not oriented), INVALID_INPUT (a NaN or
  * infinite query, with its index; outputs untouched). Cost: O(count × log cells). */

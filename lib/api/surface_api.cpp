@@ -1,5 +1,6 @@
 // The C ABI of gmpu_surface: a state machine over the pipeline's stages
 // (points → fitted → oriented), each verb checking that the stage before it is done.
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -7,6 +8,8 @@
 #include <limits>
 #include <memory>
 #include <string>
+#include <system_error>
+#include <thread>
 #include <utility>
 
 #include "api/guard.hpp"
@@ -64,12 +67,39 @@ using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 // A long stage (fit, orient, polygonize) behind the exception firewall. Whether it succeeds
-// or fails, its temporaries are freed by the time it returns: hand them back to the OS.
+// or fails, its temporaries are freed by the time it returns: hand them back to the OS. A
+// successful stage did so itself before its final report (finish_stage); a failed one does
+// here, except a cancelled one, which the caller wants back at once (the next stage or
+// destroy hands the memory back).
 template <class Body>
 gmpu_status run_stage(gmpu_surface *s, Body &&body) noexcept {
     const gmpu_status status = guarded(s ? &s->last_error : nullptr, std::forward<Body>(body));
-    gmpu::release_free_memory();
+    if (status != GMPU_OK && status != GMPU_ERROR_CANCELLED) gmpu::release_free_memory();
     return status;
+}
+
+// The end of a successful stage, before it commits its result. The temporaries are freed by
+// now; handing their memory back to the OS can take tens of milliseconds of CPU, so it runs
+// on a helper thread while this one keeps reporting (the callback's cadence is the calling
+// thread's promise). Then the final report (fraction 1), after which nothing slow follows; a
+// cancel on it counts.
+void finish_stage(gmpu::Progress &progress) {
+    std::atomic<bool> trimmed{false};
+    try {
+        std::thread trimmer([&] {
+            gmpu::release_free_memory();
+            trimmed = true;
+        });
+        while (!trimmed) {
+            std::this_thread::sleep_for(std::chrono::milliseconds(2));
+            progress.report(0.0);  // repeats the last fraction
+        }
+        trimmer.join();
+    } catch (const std::system_error &) {  // no thread to spare: trim here
+        gmpu::release_free_memory();
+    }
+    progress.report(1.0, true);
+    progress.throw_if_cancelled();
 }
 
 struct ParamSpec {
@@ -338,10 +368,10 @@ GMPU_API gmpu_status gmpu_surface_fit(gmpu_surface *s) {
         auto t0 = Clock::now();
         gmpu::Progress progress(s->progress_fn, s->progress_user, GMPU_STAGE_FIT);
         progress.report(0.0, true);
-        const double noise = gmpu::estimate_noise(s->points);
+        const double noise = gmpu::estimate_noise(s->points, progress);
         const double epsilon = gmpu::effective_epsilon(s->points, s->params, noise);
         gmpu::Octree tree = gmpu::build_octree(s->points, s->params, epsilon, progress);
-        progress.throw_if_cancelled();  // a cancel on the final report counts too
+        finish_stage(progress);
         s->discard_fit();
         s->tree = std::move(tree);
         s->noise = noise;
@@ -374,8 +404,7 @@ GMPU_API gmpu_status gmpu_surface_orient(gmpu_surface *s) {
         gmpu::measure_points(tree, s->points, threads, progress, measures);
         s->measures = std::move(measures);
         s->winding = gmpu::WindingField(tree, s->points, s->measures.normals, s->measures.area, &progress);
-        progress.report(1.0, true);
-        progress.throw_if_cancelled();  // a cancel on the final report counts too
+        finish_stage(progress);
         s->orient_stats = stats;
         s->stage = gmpu_surface::Stage::oriented;
         s->seconds[GMPU_STAGE_ORIENT] = since(t0);
@@ -434,7 +463,7 @@ GMPU_API gmpu_status gmpu_surface_polygonize(gmpu_surface *s, gmpu_mesh **out) {
         const gmpu::MpuFunction mpu(s->tree, s->params.level);
         auto mesh = std::make_unique<gmpu_mesh>();
         mesh->mesh = gmpu::polygonize(mpu, s->winding, s->points, s->measures, resolution, s->params, progress);
-        progress.throw_if_cancelled();  // a cancel on the final report counts too
+        finish_stage(progress);
         s->last_resolution = resolution;
         s->seconds[GMPU_STAGE_POLYGONIZE] = since(t0);
         *out = mesh.release();

@@ -5,7 +5,6 @@
 namespace gmpu {
 
 namespace {
-constexpr auto kReportInterval = std::chrono::milliseconds(20);
 const char *stage_name(gmpu_stage stage) {
     switch (stage) {
         case GMPU_STAGE_FIT: return "fit";

@@ -1,19 +1,32 @@
 // Progress reporting and cancellation for one long call (fit, orient, polygonize).
 // Workers only read `cancelled()`; the calling thread alone invokes the user's callback,
-// at most every few milliseconds, so a slow callback never throttles the workers.
+// at most every kReportInterval, so a slow callback never throttles the workers.
+//
+// The promise of gmpu.h: a callback at least every kMaxWorkBetweenReports of the calling
+// thread's CPU time, and a return within kMaxCancelLatency of a cancel. Every loop the
+// calling thread runs therefore polls: per item (poll) when it knows its fraction, or with
+// tick() deep inside work shared with the workers (a fit, a block), which reports only
+// when it runs on the calling thread.
 #pragma once
 
 #include <atomic>
 #include <chrono>
+#include <thread>
 
 #include "core/error.hpp"
 #include "gmpu/gmpu.h"
 
 namespace gmpu {
 
+// The cadence gmpu.h documents (tests/c/test_docs_match.cpp checks the header's figures).
+constexpr auto kReportInterval = std::chrono::milliseconds(20);        // at most this often
+constexpr auto kMaxWorkBetweenReports = std::chrono::milliseconds(50);  // at least this often
+constexpr auto kMaxCancelLatency = std::chrono::milliseconds(100);
+
 class Progress {
 public:
-    Progress(gmpu_progress_fn fn, void *user, gmpu_stage stage) : fn_(fn), user_(user), stage_(stage) {}
+    Progress(gmpu_progress_fn fn, void *user, gmpu_stage stage)
+        : fn_(fn), user_(user), stage_(stage), caller_(std::this_thread::get_id()) {}
 
     // Calling thread only. Reports `fraction` if enough time has passed since the last report
     // (always when force is set) and records a cancellation request.
@@ -33,12 +46,21 @@ public:
         throw_if_cancelled();
     }
 
+    // From any thread, inside work too long to go without a report (one cell's fit, one
+    // block): on the calling thread it reports the last fraction again (throttled); on
+    // every thread it throws CANCELLED once cancelled, which parallel_for carries back.
+    void tick() {
+        if (std::this_thread::get_id() == caller_) report(last_fraction_);
+        throw_if_cancelled();
+    }
+
     gmpu_stage stage() const { return stage_; }
 
 private:
     gmpu_progress_fn fn_;
     void *user_;
     gmpu_stage stage_;
+    std::thread::id caller_;
     double last_fraction_ = 0.0;
     std::atomic<bool> cancelled_{false};
     std::chrono::steady_clock::time_point last_report_{};

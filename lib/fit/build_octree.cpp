@@ -25,6 +25,7 @@ struct Builder {
     const PointSet &points;
     const Params &params;
     double epsilon;  // ε in normalised units
+    Progress &progress;
     Octree tree;
 
     double support_radius(double size) const { return params.support_scale * std::sqrt(3.0) * size; }
@@ -37,6 +38,8 @@ struct Builder {
     // Gathers the support and fits it; returns false when the ball holds no point and the
     // cube is empty (the cell is not created).
     bool fit(Cell &c, bool cube_has_points, PiecewiseShape &piece) const {
+        // Near the root one cell's children take tens of milliseconds: report between fits.
+        progress.tick();
         thread_local std::vector<uint32_t> idx;
         thread_local std::vector<float> d2;
         thread_local PointList support;
@@ -142,7 +145,7 @@ struct Builder {
                                                    "GMPU_PARAM_MAX_DEPTH");
     }
 
-    Octree run(Progress &progress) {
+    Octree run() {
         const size_t n = points.size();
         tree.order.resize(n);
         std::iota(tree.order.begin(), tree.order.end(), 0u);
@@ -209,8 +212,7 @@ struct Builder {
                 p.reach = std::max(p.reach, (c.centre - p.centre).norm() + c.reach);
             }
         }
-        progress.report(1.0, true);
-        return std::move(tree);
+        return std::move(tree);  // the caller makes the final report
     }
 };
 
@@ -222,8 +224,8 @@ double effective_epsilon(const PointSet &points, const Params &params, double no
 }
 
 Octree build_octree(const PointSet &points, const Params &params, double epsilon, Progress &progress) {
-    Builder b{points, params, epsilon, {}};
-    return b.run(progress);
+    Builder b{points, params, epsilon, progress, {}};
+    return b.run();
 }
 
 }  // namespace gmpu

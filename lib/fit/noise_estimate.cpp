@@ -24,7 +24,7 @@ double median(std::vector<double> &v) {
 }
 
 // Median residual of local quadratic fits over k-neighbourhoods, and their median radius.
-void measure(const PointSet &points, size_t k, double &noise, double &radius) {
+void measure(const PointSet &points, size_t k, Progress &progress, double &noise, double &radius) {
     const size_t n = points.size();
     const size_t step = std::max<size_t>(1, n / kSamples);
     std::vector<double> rms, radii;
@@ -32,6 +32,7 @@ void measure(const PointSet &points, size_t k, double &noise, double &radius) {
     std::vector<float> d2;
     PointList local;
     for (size_t i = 0; i < n; i += step) {
+        progress.tick();
         const Eigen::Vector3d centre = points.point(i);
         points.nearest(centre, k, idx, d2);
         if (idx.size() < 10) continue;
@@ -52,12 +53,12 @@ void measure(const PointSet &points, size_t k, double &noise, double &radius) {
 }
 }  // namespace
 
-double estimate_noise(const PointSet &points) {
+double estimate_noise(const PointSet &points, Progress &progress) {
     double noise, radius;
-    measure(points, kNeighbours, noise, radius);
+    measure(points, kNeighbours, progress, noise, radius);
     if (radius > 0.0 && noise > kHeavyNoise * radius && points.size() > 4 * kWideNeighbours) {
         double wide, wide_radius;
-        measure(points, kWideNeighbours, wide, wide_radius);
+        measure(points, kWideNeighbours, progress, wide, wide_radius);
         noise = std::max(noise, wide);
     }
     return noise;

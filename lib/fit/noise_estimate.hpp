@@ -6,11 +6,12 @@
 // floor for ε.
 #pragma once
 
+#include "core/progress.hpp"
 #include "geometry/point_set.hpp"
 
 namespace gmpu {
 
-// σ̂ in the normalised frame.
-double estimate_noise(const PointSet &points);
+// σ̂ in the normalised frame. Runs on the calling thread; polls progress per sample.
+double estimate_noise(const PointSet &points, Progress &progress);
 
 }  // namespace gmpu

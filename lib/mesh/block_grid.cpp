@@ -6,7 +6,7 @@
 namespace gmpu {
 
 BlockGrid::BlockGrid(const PointSet &points, int resolution, const std::vector<float> &reach, double min_reach,
-                     const WindingField &winding) {
+                     const WindingField &winding, Progress &progress) {
     h = 1.0 / resolution;  // the longest side of the normalised box is 1
     double widest = min_reach;
     for (float r : reach) widest = std::max(widest, double(r));
@@ -21,8 +21,8 @@ BlockGrid::BlockGrid(const PointSet &points, int resolution, const std::vector<f
         blocks[d] = std::max<int64_t>(1, int64_t(std::ceil(extent / (h * B))));
         cubes[d] = blocks[d] * B;
     }
-    mark_band(points, reach, min_reach);
-    sign_far_regions(winding);
+    mark_band(points, reach, min_reach, progress);
+    sign_far_regions(winding, progress);
 }
 
 Eigen::AlignedBox3d BlockGrid::block_box(int64_t id) const {
@@ -32,10 +32,12 @@ Eigen::AlignedBox3d BlockGrid::block_box(int64_t id) const {
     return Eigen::AlignedBox3d(lo, lo + Eigen::Vector3d::Constant(B * h));
 }
 
-void BlockGrid::mark_band(const PointSet &points, const std::vector<float> &reach, double min_reach) {
+void BlockGrid::mark_band(const PointSet &points, const std::vector<float> &reach, double min_reach,
+                          Progress &progress) {
     band.assign(size_t(blocks[0] * blocks[1] * blocks[2]), 0);
     const double block = B * h;
     for (size_t i = 0; i < points.size(); ++i) {
+        if (i % 4096 == 0) progress.tick();  // O(n) on the calling thread
         const double r = std::max(double(reach[i]), min_reach);
         const Eigen::Vector3d p = points.point(i) - origin;
         int64_t lo[3], hi[3];
@@ -51,13 +53,14 @@ void BlockGrid::mark_band(const PointSet &points, const std::vector<float> &reac
     }
 }
 
-void BlockGrid::sign_far_regions(const WindingField &winding) {
+void BlockGrid::sign_far_regions(const WindingField &winding, Progress &progress) {
     const int64_t nb = int64_t(band.size());
     std::vector<int32_t> region(size_t(nb), -1);
     std::vector<int8_t> region_sign;
     std::vector<int64_t> stack;
     const int64_t step[3] = {1, blocks[0], blocks[0] * blocks[1]};
     for (int64_t s = 0; s < nb; ++s) {
+        if (s % 4096 == 0) progress.tick();  // one winding query per region, O(blocks) in all
         if (band[size_t(s)] || region[size_t(s)] >= 0) continue;
         // Block 0 is at the grid's corner, outside the band: region 0 is outside.
         const int32_t id = int32_t(region_sign.size());

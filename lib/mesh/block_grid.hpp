@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "core/progress.hpp"
 #include "geometry/point_set.hpp"
 #include "implicit/winding_field.hpp"
 
@@ -29,7 +30,7 @@ struct BlockGrid {
 
     // `reach[i]`: how far from point i the band must extend (its trust radius).
     BlockGrid(const PointSet &points, int resolution, const std::vector<float> &reach, double min_reach,
-              const WindingField &winding);
+              const WindingField &winding, Progress &progress);
 
     Eigen::Vector3d corner(int64_t x, int64_t y, int64_t z) const {
         return origin + h * Eigen::Vector3d(double(x), double(y), double(z));
@@ -54,8 +55,8 @@ struct BlockGrid {
     size_t block_count() const { return band.size(); }
 
 private:
-    void mark_band(const PointSet &points, const std::vector<float> &reach, double min_reach);
-    void sign_far_regions(const WindingField &winding);
+    void mark_band(const PointSet &points, const std::vector<float> &reach, double min_reach, Progress &progress);
+    void sign_far_regions(const WindingField &winding, Progress &progress);
 };
 
 }  // namespace gmpu

@@ -6,24 +6,29 @@
 namespace gmpu {
 
 namespace {
+constexpr size_t kTickEvery = 4096;  // items between progress ticks: well under a millisecond
+
 uint32_t find(std::vector<uint32_t> &parent, uint32_t x) {
     while (parent[x] != x) x = parent[x] = parent[parent[x]];
     return x;
 }
 }  // namespace
 
-uint32_t vertex_components(const Mesh &mesh, std::vector<uint32_t> &component) {
+uint32_t vertex_components(const Mesh &mesh, std::vector<uint32_t> &component, Progress &progress) {
     const size_t n = mesh.vertex_count();
     std::vector<uint32_t> parent(n);
     std::iota(parent.begin(), parent.end(), 0u);
-    for (size_t t = 0; t < mesh.triangles.size(); t += 3)
+    for (size_t t = 0; t < mesh.triangles.size(); t += 3) {
+        if (t % (3 * kTickEvery) == 0) progress.tick();
         for (int e = 1; e < 3; ++e) {
             uint32_t a = find(parent, mesh.triangles[t]), b = find(parent, mesh.triangles[t + e]);
             if (a != b) parent[std::max(a, b)] = std::min(a, b);
         }
+    }
     component.assign(n, UINT32_MAX);
     uint32_t count = 0;
     for (size_t v = 0; v < n; ++v) {
+        if (v % kTickEvery == 0) progress.tick();
         uint32_t r = find(parent, uint32_t(v));
         if (component[r] == UINT32_MAX) component[r] = count++;
         component[v] = component[r];
@@ -31,9 +36,10 @@ uint32_t vertex_components(const Mesh &mesh, std::vector<uint32_t> &component) {
     return count;
 }
 
-void remove_unsupported_components(Mesh &mesh, const std::vector<uint32_t> &votes, uint32_t min_votes) {
+void remove_unsupported_components(Mesh &mesh, const std::vector<uint32_t> &votes, uint32_t min_votes,
+                                   Progress &progress) {
     std::vector<uint32_t> component;
-    const uint32_t count = vertex_components(mesh, component);
+    const uint32_t count = vertex_components(mesh, component, progress);
     std::vector<uint64_t> support(count, 0);
     for (size_t v = 0; v < votes.size(); ++v) support[component[v]] += votes[v];
     bool any_removed = false;
@@ -41,8 +47,12 @@ void remove_unsupported_components(Mesh &mesh, const std::vector<uint32_t> &vote
     if (!any_removed) return;
 
     std::vector<uint32_t> remap(mesh.vertex_count(), UINT32_MAX);
-    Mesh kept;
+    Mesh kept;  // reserved: growing by doubling would copy megabytes between ticks
+    kept.vertices.reserve(mesh.vertices.size());
+    kept.normals.reserve(mesh.normals.size());
+    kept.triangles.reserve(mesh.triangles.size());
     for (size_t v = 0; v < mesh.vertex_count(); ++v) {
+        if (v % kTickEvery == 0) progress.tick();
         if (support[component[v]] < min_votes) continue;
         remap[v] = uint32_t(kept.vertex_count());
         kept.vertices.insert(kept.vertices.end(), mesh.vertices.begin() + long(3 * v), mesh.vertices.begin() + long(3 * v + 3));
@@ -50,6 +60,7 @@ void remove_unsupported_components(Mesh &mesh, const std::vector<uint32_t> &vote
             kept.normals.insert(kept.normals.end(), mesh.normals.begin() + long(3 * v), mesh.normals.begin() + long(3 * v + 3));
     }
     for (size_t t = 0; t < mesh.triangles.size(); t += 3) {
+        if (t % (3 * kTickEvery) == 0) progress.tick();
         if (remap[mesh.triangles[t]] == UINT32_MAX) continue;
         for (int e = 0; e < 3; ++e) kept.triangles.push_back(remap[mesh.triangles[t + e]]);
     }

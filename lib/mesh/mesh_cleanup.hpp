@@ -5,15 +5,18 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/progress.hpp"
 #include "mesh/mesh.hpp"
 
 namespace gmpu {
 
-// Connected component (by shared vertices) of every vertex; returns the count.
-uint32_t vertex_components(const Mesh &mesh, std::vector<uint32_t> &component);
+// Connected component (by shared vertices) of every vertex; returns the count. Both run on
+// the calling thread over the whole mesh, so they tick progress every few thousand items.
+uint32_t vertex_components(const Mesh &mesh, std::vector<uint32_t> &component, Progress &progress);
 
 // Drops every connected component whose vertices received fewer than `min_votes` votes
 // in total (votes: one count per vertex), and compacts the vertex arrays.
-void remove_unsupported_components(Mesh &mesh, const std::vector<uint32_t> &votes, uint32_t min_votes);
+void remove_unsupported_components(Mesh &mesh, const std::vector<uint32_t> &votes, uint32_t min_votes,
+                                   Progress &progress);
 
 }  // namespace gmpu

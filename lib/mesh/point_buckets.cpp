@@ -13,7 +13,11 @@ PointBuckets::PointBuckets(const BlockGrid &g, const std::vector<int64_t> &band,
     // 1. Representatives: sort by voxel, keep the first (lowest index) of each.
     const double voxel = 0.5 * g.h;
     std::vector<std::pair<uint64_t, uint32_t>> keyed(points.size());
+    // Every loop over the points or the blocks runs on the calling thread: poll every few
+    // thousand items (a million points take tens of milliseconds per loop).
+    constexpr size_t kPollEvery = 4096;
     for (uint32_t i = 0; i < points.size(); ++i) {
+        if (i % kPollEvery == 0) progress.poll(fraction);
         const Eigen::Vector3d v = (points.point(i) - g.origin) / voxel;
         keyed[i] = {uint64_t(std::max(0.0, v[0])) | uint64_t(std::max(0.0, v[1])) << 21 |
                         uint64_t(std::max(0.0, v[2])) << 42,
@@ -22,6 +26,7 @@ PointBuckets::PointBuckets(const BlockGrid &g, const std::vector<int64_t> &band,
     cancellable_sort(keyed, progress, fraction);
     std::vector<uint32_t> rep, count;
     for (size_t k = 0; k < keyed.size(); ++k) {
+        if (k % kPollEvery == 0) progress.poll(fraction);
         if (k > 0 && keyed[k].first == keyed[k - 1].first) {
             ++count.back();
         } else {
@@ -54,17 +59,22 @@ PointBuckets::PointBuckets(const BlockGrid &g, const std::vector<int64_t> &band,
     };
     progress.poll(fraction);
     offsets.assign(band.size() + 1, 0);
-    for (uint32_t p : rep) for_blocks(p, [&](size_t b) { ++offsets[b + 1]; });
+    for (size_t k = 0; k < rep.size(); ++k) {
+        if (k % kPollEvery == 0) progress.poll(fraction);
+        for_blocks(rep[k], [&](size_t b) { ++offsets[b + 1]; });
+    }
     for (size_t b = 0; b < band.size(); ++b) offsets[b + 1] += offsets[b];
     point.resize(offsets.back());
     weight.resize(offsets.back());
     progress.poll(fraction);
     std::vector<uint32_t> fill(offsets.begin(), offsets.end() - 1);
-    for (size_t k = 0; k < rep.size(); ++k)
+    for (size_t k = 0; k < rep.size(); ++k) {
+        if (k % kPollEvery == 0) progress.poll(fraction);
         for_blocks(rep[k], [&](size_t b) {
             point[fill[b]] = rep[k];
             weight[fill[b]++] = count[k];
         });
+    }
 }
 
 }  // namespace gmpu

@@ -216,14 +216,28 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuck
 // `votes` receives the point votes per welded vertex.
 Mesh weld(std::vector<BlockOutput> &blocks, const Normalisation &norm, Progress &progress,
           std::vector<uint32_t> &votes) {
+    // Every big array is reserved up front: growing one by doubling copies tens of
+    // megabytes in one go, with no progress report in between.
+    size_t vertex_slots = 0, triangle_slots = 0;
+    for (const BlockOutput &block : blocks) vertex_slots += block.vertex_key.size(), triangle_slots += block.triangles.size();
     std::vector<std::pair<uint64_t, uint64_t>> keyed;  // (edge key, block << 32 | local index)
+    keyed.reserve(vertex_slots);
     for (size_t b = 0; b < blocks.size(); ++b) {
         progress.poll(0.95);
         for (size_t v = 0; v < blocks[b].vertex_key.size(); ++v) keyed.push_back({blocks[b].vertex_key[v], uint64_t(b) << 32 | v});
     }
     cancellable_sort(keyed, progress, 0.96);
 
+    size_t welded = 0;
+    for (size_t k = 0; k < keyed.size(); ++k) {
+        if (k % 65536 == 0) progress.poll(0.97);
+        welded += k == 0 || keyed[k].first != keyed[k - 1].first;
+    }
     Mesh mesh;
+    mesh.vertices.reserve(3 * welded);
+    mesh.normals.reserve(3 * welded);
+    mesh.triangles.reserve(triangle_slots);
+    votes.reserve(welded);
     std::vector<std::vector<uint32_t>> remap(blocks.size());
     for (size_t b = 0; b < blocks.size(); ++b) remap[b].resize(blocks[b].vertex_key.size());
     for (size_t k = 0; k < keyed.size(); ++k) {
@@ -264,7 +278,7 @@ int default_resolution(const Octree &tree) {
 Mesh polygonize(const MpuFunction &mpu, const WindingField &winding, const PointSet &points,
                 const PointMeasures &measures, int resolution, const Params &params, Progress &progress) {
     const double h = 1.0 / resolution, min_trust = 2.0 * h;
-    const BlockGrid g(points, resolution, measures.trust_radius, min_trust, winding);
+    const BlockGrid g(points, resolution, measures.trust_radius, min_trust, winding, progress);
     // A band block meets some point's reach, so each of its corners has a point within that
     // reach plus the block's diagonal: the bound for every neighbour search below.
     const double reach = std::max(measures.widest_trust, min_trust) + B * std::sqrt(3.0) * h + h;
@@ -288,15 +302,14 @@ Mesh polygonize(const MpuFunction &mpu, const WindingField &winding, const Point
                         "the mesh needs more than GMPU_PARAM_MAX_TRIANGLES = " +
                             std::to_string(uint64_t(params.max_triangles)) +
                             " triangles; lower GMPU_PARAM_RESOLUTION or raise the cap");
-    }, 0.02 * total, total, 4);
+    }, 0.02 * total, total, 1);  // one block per chunk: a cancel waits for one block per thread
     progress.throw_if_cancelled();
     progress.report(0.95);
     std::vector<uint32_t> votes;
     Mesh mesh = weld(blocks, points.normalisation(), progress, votes);
     progress.throw_if_cancelled();
-    remove_unsupported_components(mesh, votes, kMinVotes);
-    progress.report(1.0, true);
-    return mesh;
+    remove_unsupported_components(mesh, votes, kMinVotes, progress);
+    return mesh;  // the caller makes the final report, once the temporaries are freed
 }
 
 }  // namespace gmpu

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <queue>
 
 #include "orient/belief_propagation.hpp"
@@ -21,7 +22,8 @@ double seed_score(const Octree &tree, const LeafGraph &g, uint32_t v) {
 
 class Front {
 public:
-    Front(const LeafGraph &g, std::vector<int8_t> &label) : g_(g), label_(label) {}
+    Front(const LeafGraph &g, std::vector<int8_t> &label, FrontOrder order)
+        : g_(g), label_(label), order_(order), queued_(order == FrontOrder::fifo ? g.size() : 0, 0) {}
 
     // Evidence from labelled neighbours: positive favours keeping the fitted sign.
     double evidence(uint32_t v) const {
@@ -35,10 +37,17 @@ public:
     void push_neighbours(uint32_t v) {
         for (uint32_t e = g_.offsets[v]; e < g_.offsets[v + 1]; ++e) {
             uint32_t u = g_.neighbour[e];
-            if (label_[u] == 0) heap_.push({std::abs(evidence(u)), u});
+            if (label_[u] != 0) continue;
+            if (order_ == FrontOrder::most_evidence_first) heap_.push({std::abs(evidence(u)), u});
+            else if (!queued_[u]) queued_[u] = 1, queue_.push_back(u);
         }
     }
     bool pop(uint32_t &v) {
+        while (!queue_.empty()) {
+            v = queue_.front();
+            queue_.pop_front();
+            if (label_[v] == 0) return true;
+        }
         while (!heap_.empty()) {
             v = heap_.top().second;
             heap_.pop();
@@ -50,6 +59,9 @@ public:
 private:
     const LeafGraph &g_;
     std::vector<int8_t> &label_;
+    FrontOrder order_;
+    std::vector<uint8_t> queued_;  // FIFO: each leaf joins the queue once
+    std::deque<uint32_t> queue_;
     // Max-heap on evidence; ties go to the lower node id (deterministic).
     struct Order {
         bool operator()(const std::pair<double, uint32_t> &a, const std::pair<double, uint32_t> &b) const {
@@ -66,6 +78,7 @@ public:
         : g_(g), label_(label), opt_(o), local_(g.size(), UINT32_MAX) {}
 
     int8_t solve(uint32_t v) {
+        if (opt_.decision == LeafDecision::weighted_vote) return vote(v);
         nodes_.clear();
         bp_.clamp.clear();
         bp_.edges.clear();
@@ -98,6 +111,11 @@ public:
     }
 
 private:
+    int8_t vote(uint32_t v) const {
+        double s = 0.0;
+        for (uint32_t e = g_.offsets[v]; e < g_.offsets[v + 1]; ++e) s += double(g_.agreement[e]) * label_[g_.neighbour[e]];
+        return s < 0.0 ? -1 : 1;
+    }
     void add(uint32_t a) {
         if (local_[a] != UINT32_MAX) return;
         local_[a] = uint32_t(nodes_.size());
@@ -127,7 +145,7 @@ std::vector<int8_t> propagate_orientation(const Octree &tree, const LeafGraph &g
         if (s > best[component[v]]) best[component[v]] = s, seed[component[v]] = v;
     }
 
-    Front front(g, label);
+    Front front(g, label, options.order);
     LocalSolver solver(g, label, options);
     size_t done = 0;
     for (uint32_t c = 0; c < component_count; ++c) {

@@ -63,7 +63,7 @@ void sign_inner_cells(Octree &tree, const PointSet &points, Progress &progress) 
 }  // namespace
 
 OrientStats orient_octree(Octree &tree, const PointSet &points, const float *normals,
-                          const Params &params, Progress &progress) {
+                          const Params &params, Progress &progress, const FrontOptions &front) {
     for (Cell &c : tree.cells) c.sign = 1, c.oriented = false;
     OrientStats stats;
     const unsigned threads = resolve_threads(params.threads);
@@ -75,7 +75,7 @@ OrientStats orient_octree(Octree &tree, const PointSet &points, const float *nor
         progress.report(0.1);
         std::vector<uint32_t> component = connected_components(graph, stats.components);
         std::vector<int8_t> label =
-            propagate_orientation(tree, graph, component, stats.components, FrontOptions{}, progress);
+            propagate_orientation(tree, graph, component, stats.components, front, progress);
         for (uint32_t v = 0; v < graph.size(); ++v) {
             Cell &c = tree.cells[graph.cell_of[v]];
             c.sign = label[v];

@@ -14,6 +14,7 @@
 #include "geometry/octree.hpp"
 #include "geometry/point_set.hpp"
 #include "implicit/mpu_function.hpp"
+#include "orient/advancing_front.hpp"
 
 namespace gmpu {
 
@@ -22,9 +23,10 @@ struct OrientStats {
     uint32_t flipped_leaves = 0;
 };
 
-// normals: 3 per point (normalised frame directions) or null.
+// normals: 3 per point (normalised frame directions) or null. `front` is for measurements
+// only (advancing_front.hpp); the C ABI always passes the defaults.
 OrientStats orient_octree(Octree &tree, const PointSet &points, const float *normals,
-                          const Params &params, Progress &progress);
+                          const Params &params, Progress &progress, const FrontOptions &front = {});
 
 // Unit outward normal at every input point: −∇f/|∇f|, or the oriented fit of the point's
 // leaf where ∇f vanishes. 3 floats per point.

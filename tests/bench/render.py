@@ -4,7 +4,14 @@ A small point-splatting renderer in numpy (no GPU, no display): each mesh is sam
 area-uniformly, the samples are projected orthographically, and per pixel the nearest
 sample wins. A sample keeps the normal of its triangle *as wound*, so a surface seen from
 its back — inside-out — is painted red, and a missing part shows the white background.
+
+A mesh path that is missing, unreadable or holds no triangle raises (Open3D's reader
+returns an empty mesh for a missing file, which once made every panel silently blank), and
+so does a panel whose mesh leaves every pixel background. A pipeline that produced no
+output is a panel given None: it is drawn grey and labelled so.
 """
+from pathlib import Path
+
 import numpy as np
 
 FRONT = np.array([0.72, 0.80, 0.92])  # outward side facing the camera
@@ -13,11 +20,20 @@ BACKGROUND = 1.0
 
 
 def read_mesh(path):
-    """(vertices n×3, triangles m×3) of a .ply / .off / .obj, through Open3D's reader."""
+    """(vertices n×3, triangles m×3) of a .ply / .off / .obj, through Open3D's reader.
+    Raises FileNotFoundError for a missing file and ValueError for one without triangles."""
+    path = Path(path)
+    if not path.is_file():
+        raise FileNotFoundError(f"mesh to render not found: {path}")
     import open3d as o3d
 
     mesh = o3d.io.read_triangle_mesh(str(path))
-    return np.asarray(mesh.vertices, dtype=np.float64), np.asarray(mesh.triangles, dtype=np.int64)
+    vertices = np.asarray(mesh.vertices, dtype=np.float64)
+    triangles = np.asarray(mesh.triangles, dtype=np.int64)
+    if len(vertices) == 0 or len(triangles) == 0:
+        raise ValueError(f"mesh to render is empty or unreadable: {path} "
+                         f"({len(vertices)} vertices, {len(triangles)} triangles)")
+    return vertices, triangles
 
 
 def camera(azimuth_deg, elevation_deg):
@@ -80,37 +96,45 @@ def render(vertices, triangles, rotation, center, half_extent, size=420, seed=0)
 
 
 def side_by_side(panels, path, title, azimuth=35, elevation=20, frame=None, size=420):
-    """panels: list of (label, mesh path or None). frame: (center, half_extent), else the
-    first readable mesh's bounding box. Writes one PNG."""
+    """panels: list of (label, mesh) where mesh is a path, a (vertices, triangles) pair, or
+    None for a pipeline that produced no output. frame: (center, half_extent), else the
+    first mesh's bounding box. Writes one PNG and returns the panel images (None for the
+    panels without output). Raises on a missing or empty mesh and on a blank panel."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    meshes = []
-    for label, mesh_path in panels:
-        try:
-            meshes.append((label, read_mesh(mesh_path) if mesh_path else None))
-        except Exception as e:  # a missing output is a panel that says so
-            meshes.append((f"{label}\n(unreadable: {e})", None))
+    meshes = [(label, read_mesh(mesh) if isinstance(mesh, (str, Path)) else mesh) for label, mesh in panels]
     if frame is None:
-        first = next((m for _, m in meshes if m is not None and len(m[0])), None)
+        first = next((m for _, m in meshes if m is not None), None)
         if first is None:
-            return
+            raise ValueError(f"{title}: no panel has a mesh to render")
         lo, hi = first[0].min(axis=0), first[0].max(axis=0)
         frame = ((lo + hi) / 2, 0.55 * np.linalg.norm(hi - lo))
     center, half_extent = frame
     rotation = camera(azimuth, elevation)
 
+    images = []
+    for label, mesh in meshes:
+        image = None
+        if mesh is not None:
+            image = render(mesh[0], mesh[1], rotation, np.asarray(center), half_extent, size)
+            if not (image != BACKGROUND).any():
+                raise ValueError(f"{title}: the panel '{label.splitlines()[0]}' is blank "
+                                 "(its mesh lies outside the frame or has no area)")
+        images.append(image)
+
     fig, axes = plt.subplots(1, len(meshes), figsize=(3.2 * len(meshes), 3.6), squeeze=False)
-    for ax, (label, mesh) in zip(axes[0], meshes):
-        if mesh is None:
+    for ax, (label, _), image in zip(axes[0], meshes, images):
+        if image is None:
             ax.imshow(np.full((size, size, 3), 0.9))
-            label = label if "\n" in label else f"{label}\n(no output)"
+            label = f"{label}\n(no output)"
         else:
-            ax.imshow(render(mesh[0], mesh[1], rotation, np.asarray(center), half_extent, size))
+            ax.imshow(image)
         ax.set_title(label, fontsize=9)
         ax.set_axis_off()
     fig.suptitle(f"{title}   (red = surface seen from inside: inside-out)", fontsize=10)
     fig.tight_layout(rect=(0, 0, 1, 0.94))
     fig.savefig(path, dpi=100)
     plt.close(fig)
+    return images

@@ -147,7 +147,8 @@ def run_one(pipeline, cloud, out_dir, metrics_exe, timeout, samples):
            "pipeline": pipeline.name, "ok": run.ok, "error": run.error, "wall": run.wall,
            "compute": run.compute, "peak_rss_mb": run.peak_rss_mb, "stages": run.stages,
            "info": run.info,
-           "load_before": load, "mesh": str(run.mesh), "cloud_path": str(cloud.path),
+           # Absolute: the report (and its renders) may be made from another directory.
+           "load_before": load, "mesh": str(Path(run.mesh).resolve()), "cloud_path": str(Path(cloud.path).resolve()),
            "gt_mesh": str(cloud.gt_mesh) if cloud.gt_mesh else None}
     if run.ok:
         row.update(score(metrics_exe, cloud, run, samples))

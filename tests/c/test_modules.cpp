@@ -20,6 +20,7 @@
 #include "fit/noise_estimate.hpp"
 #include "geometry/point_set.hpp"
 #include "implicit/mpu_function.hpp"
+#include "implicit/winding_field.hpp"
 #include "mesh/marching_tetrahedra.hpp"
 #include "mesh/mesh_cleanup.hpp"
 #include "orient/belief_propagation.hpp"
@@ -130,11 +131,12 @@ void robust_taubin_error(void **) {
 }
 
 void noise_estimate_tracks_the_noise(void **) {
+    Progress quiet(nullptr, nullptr, GMPU_STAGE_FIT);
     for (double sigma : {0.0, 0.005, 0.02}) {
         std::vector<double> xyz = flat(sphere_points(30000, 1.0, sigma, 17));
         PointSet ps = PointSet::from_array(xyz.data(), 30000, 0, 15);
         // In normalised units: the sphere's longest side (2) becomes 1.
-        double est = estimate_noise(ps) * 2.0;
+        double est = estimate_noise(ps, quiet) * 2.0;
         fprintf(stderr, "  sigma %.3f estimated %.4f\n", sigma, est);
         if (sigma == 0) assert_true(est < 0.001);
         else assert_true(est > 0.6 * sigma && est < 1.3 * sigma);
@@ -229,6 +231,58 @@ void blend_finds_every_covering_leaf(void **) {
         const double a = f.value(x, &g1), b = f.value_among(near, x, &g2);
         assert_true(a == b && g1 == g2);
     }
+}
+
+// ---- the winding number ----------------------------------------------------------------
+
+void winding_number_of_a_sampled_sphere(void **) {
+    // A Fibonacci sphere (near-uniform) with its radial outward normals, each point standing
+    // for an equal share of the area: about 1 inside, 0 outside, and 1/2 on the surface
+    // (at a sample, whose own term is left out, the rest of the sphere sees half the solid
+    // angle). The octree makes far cells one dipole each; near the sphere and at the centre
+    // the answer must still be right. A 0.05 % radial jitter keeps one quadric from fitting
+    // the whole sphere, so the octree is deep.
+    const size_t n = 20000;
+    std::vector<double> xyz;
+    const double golden = M_PI * (3.0 - std::sqrt(5.0));
+    for (size_t i = 0; i < n; ++i) {
+        double z = 1.0 - 2.0 * (double(i) + 0.5) / double(n), s = std::sqrt(1.0 - z * z);
+        const double jitter = 1.0 + 0.0005 * std::sin(1.7 * double(i));
+        xyz.insert(xyz.end(), {jitter * s * std::cos(golden * double(i)), jitter * s * std::sin(golden * double(i)),
+                               jitter * z});
+    }
+    PointSet ps = PointSet::from_array(xyz.data(), n, 0, 15);
+    const double r = ps.normalisation().scale;  // the unit sphere in the normalised frame
+    std::vector<float> normals(3 * n), area(n, float(4.0 * M_PI * r * r / double(n)));
+    for (size_t i = 0; i < n; ++i) {
+        Vector3d u = ps.point(i).normalized();
+        for (int d = 0; d < 3; ++d) normals[3 * i + d] = float(u[d]);
+    }
+    Params params;
+    Progress progress(nullptr, nullptr, GMPU_STAGE_ORIENT);
+    Octree tree = build_octree(ps, params, 1e-5, progress);  // below the jitter: a deep octree
+    assert_true(tree.cells.size() > 100);
+    WindingField w(tree, ps, normals, area, &progress);
+    std::mt19937_64 rng(3);
+    std::normal_distribution<double> g(0, 1);
+    // Summed exactly (every cell opened: a huge far ratio), then with the default far
+    // ratio, whose dipoles are a few percent off: enough to tell 0 from 1.
+    assert_near(w.winding(Vector3d::Zero(), 1e6), 1.0, 0.005);
+    assert_near(w.winding(Vector3d(0, 0, 2 * r), 1e6), 0.0, 0.005);
+    for (int q = 0; q < 200; ++q) {
+        Vector3d dir = Vector3d(g(rng), g(rng), g(rng)).normalized();
+        assert_near(w.winding(0.0 * dir), 1.0, 0.05);
+        assert_near(w.winding(0.5 * r * dir), 1.0, 0.05);
+        assert_near(w.winding(0.9 * r * dir), 1.0, 0.05);
+        assert_near(w.winding(1.1 * r * dir), 0.0, 0.05);
+        assert_near(w.winding(3.0 * r * dir), 0.0, 0.01);
+        assert_near(w.winding(ps.point(size_t(q) * 97)), 0.5, 0.05);
+    }
+    // Normals turned inward: the solid is the outside, so −1 inside.
+    for (float &c : normals) c = -c;
+    WindingField inverted(tree, ps, normals, area, &progress);
+    assert_near(inverted.winding(Vector3d::Zero(), 1e6), -1.0, 0.005);
+    assert_true(WindingField().winding(Vector3d::Zero()) == 0.0);  // empty: no opinion
 }
 
 // ---- belief propagation ---------------------------------------------------------------
@@ -340,8 +394,9 @@ void unsupported_components_are_dropped(void **) {
         m.triangles.insert(m.triangles.end(), {b, b + 2, b + 1, b, b + 1, b + 3, b, b + 3, b + 2, b + 1, b + 2, b + 3});
     }
     std::vector<uint32_t> comp;
-    assert_int_equal(vertex_components(m, comp), 2);
-    remove_unsupported_components(m, {0, 0, 0, 0, 1, 2, 0, 0}, 3);
+    Progress quiet(nullptr, nullptr, GMPU_STAGE_POLYGONIZE);
+    assert_int_equal(vertex_components(m, comp, quiet), 2);
+    remove_unsupported_components(m, {0, 0, 0, 0, 1, 2, 0, 0}, 3, quiet);
     assert_int_equal(m.vertex_count(), 4);
     assert_int_equal(m.triangle_count(), 4);
     assert_near(m.vertices[0], 5.0, 0);
@@ -410,6 +465,7 @@ int main(void) {
         cmocka_unit_test(point_set_validation),
         cmocka_unit_test(point_set_normalises_and_searches),
         cmocka_unit_test(blend_finds_every_covering_leaf),
+        cmocka_unit_test(winding_number_of_a_sampled_sphere),
         cmocka_unit_test(bp_follows_clamped_evidence),
         cmocka_unit_test(bp_data_term_breaks_ties_only),
         cmocka_unit_test(tetrahedra_cases_separate_signs),

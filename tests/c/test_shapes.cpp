@@ -4,13 +4,16 @@
 // torus (a handle), nested spheres (a shell inside a shell: the inner normals must point
 // into the cavity), a thin plate (two close sheets BP must not merge), islands.
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <vector>
 
+#include "aabb_tree.hpp"
 #include "analytic_shapes.hpp"
 #include "mesh_checks.hpp"
 #include "metrics.hpp"
 #include "reconstruct.hpp"
+#include "sampling.hpp"
 
 #include <setjmp.h>
 #include <stdarg.h>
@@ -209,6 +212,139 @@ void level_of_detail(void **) {
     assert_true(a[0] != b[0]);
 }
 
+// An exact sphere is one quadric: the root cell fits it and neither subdivision nor belief
+// propagation runs (the sphere test above). With a little noise, no noise floor and a tiny
+// ε, every cell misses ε and the octree goes down to MAX_DEPTH: hundreds of bivariate
+// leaves whose fitted signs are arbitrary (the PCA normal's direction), which orient must
+// make agree.
+void sphere_that_subdivides(void **) {
+    Sphere shape({0.2, -0.1, 0.3}, 1.0);
+    OrientedPoints pts = shape.sample(20000, 13);
+    add_gaussian_noise(pts.positions, 0.0005, 14);
+    Reconstruction r = reconstruct(pts.positions,
+                                   {{GMPU_PARAM_NOISE_SCALE, 0}, {GMPU_PARAM_ERROR, 1e-5}, {GMPU_PARAM_MAX_DEPTH, 4}});
+    assert_int_equal(r.status, GMPU_OK);
+    const double depth = r.stat(GMPU_STAT_DEPTH), leaves = r.stat(GMPU_STAT_LEAVES),
+                 flipped = r.stat(GMPU_STAT_FLIPPED_CELLS);
+    const double orientation = orientation_accuracy(r.normals, pts.normals).accuracy;
+    fprintf(stderr, "  depth %.0f, %.0f leaves, %.0f flipped by orient, orientation %.4f%%\n", depth, leaves, flipped,
+            100 * orientation);
+    assert_true(depth == 4);
+    assert_true(leaves > 200);
+    assert_true(flipped > 0.2 * leaves && flipped < 0.8 * leaves);  // orient had work to do
+    assert_true(r.stat(GMPU_STAT_COMPONENTS) == 1);
+    assert_true(orientation >= 0.999);
+    MeshCheck check = check_mesh(r.mesh);
+    assert_true(check.watertight);
+    assert_int_equal(check.components, 1);
+    assert_int_equal(check.component_reports[0].genus, 0);
+    assert_true(check.signed_volume > 0);
+}
+
+// GMPU_PARAM_LEVEL on one fitted, oriented surface: the mesh at every level is closed; from
+// the coarsest level whose cells can hold the shape on, it has the shape's topology, and
+// all levels together are far closer to the truth than the coarsest. Level 1 (eight cells)
+// cannot hold a torus: it comes out closed but with genus 4 (measured); from level 2 on the
+// torus is a torus. A sphere is one at every level.
+void level_of_detail_keeps_topology(void **) {
+    const Torus torus({0, 0, 0}, 1.0, 0.3);
+    const Sphere sphere({0, 0, 0}, 1.0);
+    struct Case {
+        const AnalyticShape *shape;
+        int genus;
+        int first_level;  // the coarsest level whose mesh has the shape's topology
+    } cases[] = {{&torus, 1, 2}, {&sphere, 0, 1}};
+    for (const Case &c : cases) {
+        OrientedPoints pts = c.shape->sample(20000, 21);
+        add_gaussian_noise(pts.positions, 0.0005, 22);  // a sphere must subdivide too (above)
+        Reconstruction r = reconstruct(pts.positions, {{GMPU_PARAM_RESOLUTION, 64}, {GMPU_PARAM_NOISE_SCALE, 0},
+                                                       {GMPU_PARAM_ERROR, 1e-5}, {GMPU_PARAM_MAX_DEPTH, 5}});
+        assert_int_equal(r.status, GMPU_OK);
+        const int depth = int(r.stat(GMPU_STAT_DEPTH));
+        assert_int_equal(depth, 5);
+        double coarsest = 0.0;
+        for (int level = 1; level <= depth + 1; ++level) {
+            const int cap = level > depth ? 0 : level;  // 0: every level
+            assert_int_equal(gmpu_surface_set_param(r.surface, GMPU_PARAM_LEVEL, cap), GMPU_OK);
+            gmpu_mesh *m = nullptr;
+            assert_int_equal(gmpu_surface_polygonize(r.surface, &m), GMPU_OK);
+            TriangleMesh mesh = mesh_from_arrays(gmpu_mesh_vertices(m), gmpu_mesh_vertex_count(m),
+                                                 gmpu_mesh_triangles(m), gmpu_mesh_triangle_count(m));
+            gmpu_mesh_destroy(m);
+            MeshCheck check = check_mesh(mesh);
+            ShapeDeviation d = compare_to_shape(mesh, *c.shape, 5000, 3);
+            fprintf(stderr, "  genus-%d shape, level %d: %zu components, genus %d, watertight %d, mean distance %.5f\n",
+                    c.genus, cap, check.components, check.components ? check.component_reports[0].genus : -1,
+                    int(check.watertight), d.mean_distance);
+            assert_true(check.watertight);  // at every level, even below first_level
+            if (level == 1) coarsest = d.mean_distance;
+            if (cap == 0) assert_true(d.mean_distance < 0.1 * coarsest);
+            if (level < c.first_level) continue;
+            assert_int_equal(check.components, 1);
+            assert_int_equal(check.component_reports[0].genus, c.genus);
+        }
+    }
+}
+
+// How far a cube's true edges and corners are from the reconstruction: mean distance to the
+// mesh, and mean |f| (about the distance to the implicit's zero set, which the polygonizer
+// then rounds at the scale of its grid).
+struct FeatureDistances {
+    double edge_mesh = 0, corner_mesh = 0, edge_f = 0, corner_f = 0;
+};
+FeatureDistances feature_distances(const Reconstruction &r, const Vec3 &centre, double half) {
+    std::vector<Vec3> edge, corner;
+    for (int axis = 0; axis < 3; ++axis)
+        for (int s = 0; s < 4; ++s)
+            for (int k = 1; k < 20; ++k) {  // along each of the 12 edges, corners excluded
+                Vec3 p = centre;
+                p[(axis + 1) % 3] += (s & 1 ? half : -half);
+                p[(axis + 2) % 3] += (s & 2 ? half : -half);
+                p[axis] += half * (-1.0 + 2.0 * k / 20.0);
+                edge.push_back(p);
+            }
+    for (int c = 0; c < 8; ++c) corner.push_back(centre + half * Vec3(c & 1 ? 1 : -1, c & 2 ? 1 : -1, c & 4 ? 1 : -1));
+    const AabbTree tree(r.mesh);
+    FeatureDistances out;
+    auto mean = [&](const std::vector<Vec3> &at, double &mesh, double &f) {
+        const std::vector<double> values = r.evaluate(at);
+        for (size_t i = 0; i < at.size(); ++i) {
+            mesh += tree.nearest(at[i]).distance / double(at.size());
+            f += std::abs(values[i]) / double(at.size());
+        }
+    };
+    mean(edge, out.edge_mesh, out.edge_f);
+    mean(corner, out.corner_mesh, out.corner_f);
+    return out;
+}
+
+void sharp_features_reach_the_edges(void **) {
+    const Vec3 centre(0.1, 0, -0.2);
+    const double half = 0.5;
+    Plate cube(centre, {half, half, half});
+    OrientedPoints pts = cube.sample(30000, 8);
+    FeatureDistances d[2];
+    for (int sharp = 0; sharp < 2; ++sharp) {
+        // The same grid for both: the automatic one follows the leaves, which differ.
+        Reconstruction r = reconstruct(pts.positions, {{GMPU_PARAM_SHARP_FEATURES, double(sharp)}, {GMPU_PARAM_RESOLUTION, 128}});
+        assert_int_equal(r.status, GMPU_OK);
+        MeshCheck check = check_mesh(r.mesh);
+        assert_true(check.watertight);
+        assert_int_equal(check.components, 1);
+        assert_int_equal(check.component_reports[0].genus, 0);
+        if (sharp) assert_true(r.stat(GMPU_STAT_PIECEWISE_CELLS) > 0);
+        else assert_true(r.stat(GMPU_STAT_PIECEWISE_CELLS) == 0);
+        d[sharp] = feature_distances(r, centre, half);
+        fprintf(stderr, "  sharp features %d: %.0f piecewise leaves; true edges: mesh %.5f, |f| %.5f; corners: mesh %.5f, "
+                        "|f| %.5f (grid cube %.4f)\n",
+                sharp, r.stat(GMPU_STAT_PIECEWISE_CELLS), d[sharp].edge_mesh, d[sharp].edge_f, d[sharp].corner_mesh,
+                d[sharp].corner_f, 2 * half / 128);
+    }
+    // Measured: about a quarter closer along the edges, both in f and in the mesh.
+    assert_true(d[1].edge_f < 0.9 * d[0].edge_f && d[1].corner_f < d[0].corner_f);
+    assert_true(d[1].edge_mesh < 0.9 * d[0].edge_mesh && d[1].corner_mesh < d[0].corner_mesh);
+}
+
 void deterministic(void **) {
     Torus shape({0, 0, 0}, 1.0, 0.35);
     OrientedPoints pts = shape.sample(15000, 11);
@@ -232,7 +368,12 @@ int main(void) {
         cmocka_unit_test(scale_invariance),
         cmocka_unit_test(input_normals_decide_the_sign),
         cmocka_unit_test(level_of_detail),
+        cmocka_unit_test(sphere_that_subdivides),
+        cmocka_unit_test(level_of_detail_keeps_topology),
+        cmocka_unit_test(sharp_features_reach_the_edges),
         cmocka_unit_test(deterministic),
     };
+    // GMPU_TEST_FILTER=sphere* runs only the matching tests (cmocka's wildcards).
+    if (const char *only = getenv("GMPU_TEST_FILTER")) cmocka_set_test_filter(only);
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }

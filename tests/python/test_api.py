@@ -85,7 +85,7 @@ def test_units_follow_the_caller(small_cloud):
         assert np.allclose(b.gradient(q * 1000 + 5), a.gradient(q), rtol=1e-6, atol=1e-9)
 
 
-def test_polygonize_overrides_apply_to_one_call(oriented):
+def test_polygonize_overrides_apply_to_one_call(oriented, small_cloud):
     before = oriented.params
     coarse = oriented.polygonize(resolution=16)
     fine = oriented.polygonize(resolution=32)
@@ -93,8 +93,23 @@ def test_polygonize_overrides_apply_to_one_call(oriented):
     assert len(fine.faces) > 2 * len(coarse.faces)
     assert oriented.stats["resolution"] == 32
     lod = oriented.polygonize(resolution=16, level=2)
-    assert len(lod.faces) > 0
     assert oriented.params == before
+    # A level-2 mesh is cruder than the full one on the same grid, but still closed,
+    # consistently wound and outward, and about where the bunny is.
+    for mesh in (coarse, lod):
+        faces = np.asarray(mesh.faces, dtype=np.int64)
+        directed = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+        keys = directed[:, 0] * len(mesh.vertices) + directed[:, 1]
+        reverse = directed[:, 1] * len(mesh.vertices) + directed[:, 0]
+        assert len(np.unique(keys)) == len(keys)  # no directed edge twice: consistent winding
+        assert np.isin(reverse, keys).all()       # every edge has its twin: closed
+        v = np.asarray(mesh.vertices)[faces]
+        assert np.einsum("ij,ij->i", v[:, 0], np.cross(v[:, 1], v[:, 2])).sum() > 0  # outward
+    pts = small_cloud[0]
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    slack = 0.1 * np.linalg.norm(hi - lo)
+    assert (np.asarray(lod.vertices) > lo - slack).all() and (np.asarray(lod.vertices) < hi + slack).all()
+    assert len(lod.vertices) != len(coarse.vertices) or not np.array_equal(lod.vertices, coarse.vertices)
 
 
 def test_params_and_stats(small_cloud):
