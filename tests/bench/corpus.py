@@ -154,6 +154,8 @@ def better_peer(runs):
         vals = [(r[key], name) for name, r in ok.items() if r.get(key) is not None]
         if vals:
             best[key], best[key + "_by"] = max(vals)
+    if "fscore_0.5_by" in best:  # the topology of the peer whose surface is the closer one
+        best["components"] = ok[best["fscore_0.5_by"]].get("components")
     times = [r["seconds"] for r in ok.values() if r.get("seconds") is not None]
     best["seconds"] = min(times) if times else None  # the faster peer
     best["seconds_kind"] = next(iter(ok.values())).get("seconds_kind")

@@ -145,11 +145,12 @@ def met_count(rows, key):
 
 
 def variant_table(rows):
-    head = ("| variant | clouds | orientation mean (worst) | F@0.5% gmpu · peer · Poisson(gmpu) "
+    head = ("| variant | clouds | orientation gmpu mean (worst) · peer mean | F@0.5% gmpu · peer · Poisson(gmpu) "
             "| F@1% gmpu · peer · Poisson(gmpu) | orientation target | F ≥ peer (0.5 · 1) "
-            "| F ≥ Poisson(gmpu) − 0.005 (0.5 · 1) | noise target | truth's topology | watertight "
+            "| F ≥ Poisson(gmpu) − 0.005 (0.5 · 1) | noise target | truth's components gmpu · peer · "
+            "Poisson(gmpu) | truth's genus (gmpu) | watertight (gmpu) "
             "| median s gmpu · Poisson(gmpu) · peer |\n"
-            "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n")
+            "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n")
     lines = []
     for variant in VARIANT_ORDER:
         mine = [r for r in rows if r["variant"] == variant]
@@ -163,16 +164,24 @@ def variant_table(rows):
         for key, _ in FSCORES:
             cells.append(" · ".join(fmt(mean(x.get(key) for x in xs), ".3f") for xs in (g, p, q)))
         topo = [right_topology(r) for r in mine if r["gmpu"].get("ok")]
+        components = " · ".join(components_right(mine, who) for who in ("gmpu", "peer", "poisson_gmpu"))
         lines.append(
-            f"| {variant} | {len(mine)} | {fmt(mean(orient), '.2%')} ({fmt(min(orient, default=None), '.2%')}) "
+            f"| {variant} | {len(mine)} | {fmt(mean(orient), '.2%')} ({fmt(min(orient, default=None), '.2%')})"
+            f" · {fmt(mean(x.get('orientation_accuracy') for x in p), '.2%')} "
             f"| {cells[0]} | {cells[1]} | {met_count(mine, 'orientation')} "
             f"| {met_count(mine, 'fscore_0.5_peer')} · {met_count(mine, 'fscore_1_peer')} "
             f"| {met_count(mine, 'fscore_0.5_poisson')} · {met_count(mine, 'fscore_1_poisson')} "
-            f"| {met_count(mine, 'noise')} | {sum(topo)}/{len(topo)} "
+            f"| {met_count(mine, 'noise')} | {components} | {sum(topo)}/{len(topo)} "
             f"| {sum(bool(x.get('watertight')) for x in g)}/{len(g)} "
             f"| {fmt(median(x.get('seconds') for x in g), '.2f')} · {fmt(median(x.get('seconds') for x in q), '.2f')}"
             f" · {fmt(median(x.get('seconds') for x in p), '.2f')} |")
     return head + "\n".join(lines) + "\n"
+
+
+def components_right(rows, who):
+    """'k/n': how many of who's meshes have the truth's component count."""
+    have = [r for r in rows if (r.get(who) or {}).get("components") is not None]
+    return f"{sum(r[who]['components'] == r['truth']['components'] for r in have)}/{len(have)}" if have else "–"
 
 
 def cloud_table(rows):
@@ -234,6 +243,7 @@ def ipsr_table(comparison):
 
 
 def section(corpus, machine, load_note=""):
+    """The README's corpus section (markdown)."""
     rows = corpus["rows"]
     comparison = ipsr_comparison(rows, corpus.get("ipsr", {}))
     live = corpus["peer_source"] == "live"
@@ -258,3 +268,30 @@ def section(corpus, machine, load_note=""):
         + ipsr_table(comparison) + "\n"
         "#### Per cloud\n\n<details><summary>" + f"{len(rows)} clouds</summary>\n\n"
         + cloud_table(rows) + "\n</details>\n")
+
+
+def write(results, folder):
+    """folder/corpus.md from the corpus results."""
+    import report
+
+    m = results["machine"]
+    text = section(results, f"{m['cpu']}, {m['cores']} cores, {m['memory_gb']} GB; run {m['date']}",
+                   report.load_note(results["rows"]))
+    (folder / "corpus.md").write_text(text)
+
+
+if __name__ == "__main__":
+    # Rebuild the section of an earlier run: corpus_report.py RESULTS_DIR/corpus
+    import json
+    import sys
+    from pathlib import Path
+
+    import corpus as corpus_run
+
+    folder = Path(sys.argv[1])
+    results = json.loads((folder / "corpus.json").read_text())
+    for r in results["rows"]:
+        r["peer"] = corpus_run.better_peer(r.get("peer_runs", {}))
+    results["ipsr"] = corpus_run.ipsr_reference()
+    write(results, folder)
+    print(f"{folder / 'corpus.md'} rewritten")

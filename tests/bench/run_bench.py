@@ -270,17 +270,12 @@ def full(args, metrics_exe, build):
 def corpus_section(args, metrics_exe, build):
     import corpus
     import corpus_report
-    import report
 
     out = args.out / "corpus"
-    args_here = argparse.Namespace(**{**vars(args), "out": out})
-    results = corpus.run_corpus(args_here, metrics_exe, build)
+    results = corpus.run_corpus(argparse.Namespace(**{**vars(args), "out": out}), metrics_exe, build)
     results["machine"] = machine()
     (out / "corpus.json").write_text(json.dumps(results, indent=1, default=str))
-    m = results["machine"]
-    text = corpus_report.section(results, f"{m['cpu']}, {m['cores']} cores, {m['memory_gb']} GB; run {m['date']}",
-                                 report.load_note(results["rows"]))
-    (out / "corpus.md").write_text(text)
+    corpus_report.write(results, out)
     print(f"corpus section in {out}/corpus.md")
     return 0
 
