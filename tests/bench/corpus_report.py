@@ -108,7 +108,7 @@ def verdict(text, judged, missed, variant):
         counts = {}
         for c in missed:
             counts[variant[c]] = counts.get(variant[c], 0) + 1
-        which = ", ".join(f"{n} {v}" for v, n in counts.items())
+        which = ", ".join(f"{counts[v]} {v}" for v in VARIANT_ORDER if v in counts)
     return f"- {text}: **missed** (met on {len(judged) - len(missed)}/{len(judged)}; missed: {which})."
 
 
@@ -148,7 +148,7 @@ def variant_table(rows):
     head = ("| variant | clouds | orientation gmpu mean (worst) · peer mean | F@0.5% gmpu · peer · Poisson(gmpu) "
             "| F@1% gmpu · peer · Poisson(gmpu) | orientation target | F ≥ peer (0.5 · 1) "
             "| F ≥ Poisson(gmpu) − 0.005 (0.5 · 1) | noise target | truth's components gmpu · peer · "
-            "Poisson(gmpu) | truth's genus (gmpu) | watertight (gmpu) "
+            "Poisson(gmpu) | truth's components and genus (gmpu) | watertight (gmpu) "
             "| median s gmpu · Poisson(gmpu) · peer |\n"
             "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n")
     lines = []
