@@ -25,7 +25,7 @@ define apt_install
 endef
 
 .PHONY: all deps deps-test deps-bench build demo test test-c test-python test-node test-rust \
-        test-sanitize bench bench-quick fuzz clean
+        test-sanitize bench bench-quick bench-corpus fuzz clean
 
 all: build
 
@@ -143,9 +143,19 @@ test-valgrind: deps-test build
 	  --wrapper 'valgrind -q --error-exitcode=1 --leak-check=full --errors-for-leak-kinds=definite,indirect' \
 	  $(VALGRIND_SUITES)
 
+# The corpus section's peers: `reference` takes the committed figures
+# (tests/data/corpus/peers.tsv), `live` runs Open3D and CGAL on all 106 clouds (hours).
+CORPUS_PEERS ?= reference
+
 bench: deps-bench build
 	$(PYTHON) tests/bench/run_bench.py --build $(BUILD) --out bench-results
+	$(PYTHON) tests/bench/run_bench.py --corpus-only --corpus-peers $(CORPUS_PEERS) --build $(BUILD) --out bench-results
 	$(PYTHON) tests/bench/update_readme.py bench-results
+
+# The corpus section alone (issue 13's targets on 106 generated clouds).
+bench-corpus: deps-bench build
+	$(PYTHON) tests/bench/run_bench.py --corpus-only --corpus-peers $(CORPUS_PEERS) --build $(BUILD) --out bench-results
+	$(PYTHON) tests/bench/update_readme.py bench-results --sections corpus
 
 # gmpu alone, against quality floors: needs no peer, so CI runs it after `make test`.
 bench-quick: deps-test build

@@ -8,6 +8,7 @@ what the gmpu/peer ratios use; `wall` is the whole child process.
 
 Run as a script, this file is the Open3D child:
     python3 pipelines.py open3d CLOUD.ply MESH.ply POINTS.ply DEPTH
+    python3 pipelines.py open3d-oriented ORIENTED.ply MESH.ply POINTS.ply DEPTH TRIM
 """
 import json
 import os
@@ -213,6 +214,23 @@ class Cgal(Pipeline):
         return [str(self.exe), str(cloud), str(mesh), str(points)]
 
 
+class PoissonOnOrientedPoints(Pipeline):
+    """Open3D's screened Poisson on points that already carry oriented normals (gmpu's own,
+    from --normals-out): what a global smooth surface makes of gmpu's orientation, the
+    reference its surface stage is measured against. Low-density vertices are trimmed the
+    way the corpus's committed Open3D figures were made (tests/data/corpus/README.md)."""
+    work_stages = ("reconstruct",)
+
+    def __init__(self, depth=8, trim_quantile=0.01, name="poisson_gmpu"):
+        self.depth, self.trim_quantile, self.name = depth, trim_quantile, name
+
+    available = Open3D.available
+
+    def command(self, oriented, mesh, points):
+        return [PYTHON, str(HERE / "pipelines.py"), "open3d-oriented", str(oriented), str(mesh),
+                str(points), str(self.depth), str(self.trim_quantile)]
+
+
 def open3d_child(cloud, mesh_path, points_path, depth):
     """The Open3D pipeline itself (runs in the child). Prints seconds per stage as JSON."""
     import open3d as o3d
@@ -249,7 +267,42 @@ def open3d_child(cloud, mesh_path, points_path, depth):
     print(json.dumps(t))
 
 
+def open3d_oriented_child(oriented, mesh_path, points_path, depth, trim_quantile):
+    """Poisson on given oriented normals (runs in the child). Prints seconds per stage."""
+    import numpy as np
+    import open3d as o3d
+
+    o3d.utility.set_verbosity_level(o3d.utility.VerbosityLevel.Error)
+    t = {}
+    start = time.perf_counter()
+    pcd = o3d.io.read_point_cloud(str(oriented))
+    if len(pcd.points) == 0 or not pcd.has_normals():
+        sys.exit(f"open3d: {oriented} has no points with normals")
+    t["read"] = time.perf_counter() - start
+
+    start = time.perf_counter()
+    mesh, densities = o3d.geometry.TriangleMesh.create_from_point_cloud_poisson(pcd, depth=depth)
+    if trim_quantile > 0:
+        densities = np.asarray(densities)
+        mesh.remove_vertices_by_mask(densities < np.quantile(densities, trim_quantile))
+    t["reconstruct"] = time.perf_counter() - start
+
+    start = time.perf_counter()
+    ok = o3d.io.write_triangle_mesh(str(mesh_path), mesh, write_vertex_normals=False,
+                                    write_vertex_colors=False)
+    ok = ok and o3d.io.write_point_cloud(str(points_path), pcd)  # the normals it was given
+    t["write"] = time.perf_counter() - start
+    if not ok:
+        sys.exit("open3d: cannot write the outputs")
+    print(json.dumps(t))
+
+
 if __name__ == "__main__":
-    if len(sys.argv) != 6 or sys.argv[1] != "open3d":
-        sys.exit("usage: pipelines.py open3d CLOUD.ply MESH.ply POINTS.ply DEPTH")
-    open3d_child(sys.argv[2], sys.argv[3], sys.argv[4], int(sys.argv[5]))
+    if len(sys.argv) == 6 and sys.argv[1] == "open3d":
+        open3d_child(sys.argv[2], sys.argv[3], sys.argv[4], int(sys.argv[5]))
+    elif len(sys.argv) == 7 and sys.argv[1] == "open3d-oriented":
+        open3d_oriented_child(sys.argv[2], sys.argv[3], sys.argv[4], int(sys.argv[5]),
+                              float(sys.argv[6]))
+    else:
+        sys.exit("usage: pipelines.py open3d CLOUD.ply MESH.ply POINTS.ply DEPTH\n"
+                 "       pipelines.py open3d-oriented ORIENTED.ply MESH.ply POINTS.ply DEPTH TRIM")

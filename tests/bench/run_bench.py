@@ -6,9 +6,13 @@ same clouds, in the same run, and are scored by the same exact metrics (gmpu-met
                         ground-truth mesh, a 10k → 1M scale series; table, plots, pictures
     make bench-quick    gmpu alone on two clouds; exits 1 when a quality floor is missed
                         (and prints what the Python binding costs against the CLI)
+    make bench-corpus   the corpus section alone (--corpus-only, tests/bench/corpus.py):
+                        106 clouds from tests/data/corpus/make.sh against issue 13's targets;
+                        `make bench` runs it too
 
-Results go to bench-results/ (results.json, results.md, *.png, renders/); then
-tests/bench/update_readme.py puts the summary into the README.
+Results go to bench-results/ (results.json, results.md, *.png, renders/; the corpus section
+in bench-results/corpus/: corpus.json, corpus.md); then tests/bench/update_readme.py puts
+the summaries into the README.
 """
 import argparse
 import json
@@ -264,6 +268,19 @@ def full(args, metrics_exe, build):
     return 0
 
 
+def corpus_section(args, metrics_exe, build):
+    import corpus
+    import corpus_report
+
+    out = args.out / "corpus"
+    results = corpus.run_corpus(argparse.Namespace(**{**vars(args), "out": out}), metrics_exe, build)
+    results["machine"] = machine()
+    (out / "corpus.json").write_text(json.dumps(results, indent=1, default=str))
+    corpus_report.write(results, out)
+    print(f"corpus section in {out}/corpus.md")
+    return 0
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", type=Path, default=ROOT / "build", help="meson build directory")
@@ -282,6 +299,12 @@ def main():
     ap.add_argument("--timeout", type=float, default=1200, help="kill a run after this (s)")
     ap.add_argument("--samples", type=int, default=100_000, help="metric samples per surface")
     ap.add_argument("--no-renders", dest="renders", action="store_false")
+    ap.add_argument("--corpus-only", action="store_true",
+                    help="only the corpus section (tests/data/corpus, issue 13)")
+    ap.add_argument("--corpus-peers", choices=("reference", "live"), default="reference",
+                    help="the peers on the corpus: committed figures (peers.tsv) or run here")
+    ap.add_argument("--corpus-repeats", type=int, default=1,
+                    help="gmpu runs per corpus cloud (the median is kept)")
     args = ap.parse_args()
 
     # Open3D's OpenMP threads spin while they wait by default; on a machine busy with
@@ -294,7 +317,11 @@ def main():
     metrics_exe = args.build / "tests" / "bench" / "gmpu-metrics"
     if not metrics_exe.exists():
         sys.exit(f"{metrics_exe} is missing: build first (make build)")
-    return quick(args, metrics_exe, args.build) if args.quick else full(args, metrics_exe, args.build)
+    if args.quick:
+        return quick(args, metrics_exe, args.build)
+    if args.corpus_only:
+        return corpus_section(args, metrics_exe, args.build)
+    return full(args, metrics_exe, args.build)
 
 
 if __name__ == "__main__":

@@ -1,13 +1,17 @@
 #!/usr/bin/python3
-"""Regenerates the README's benchmark section from a `make bench` run.
+"""Regenerates the README's benchmark sections from a `make bench` run.
 
     update_readme.py [RESULTS_DIR] [--readme README.md] [--assets docs/bench]
+                     [--sections bench,corpus]
 
-Replaces what lies between the `<!-- bench:begin -->` and `<!-- bench:end -->` lines of
-the README (or, failing those, `<!-- results:begin -->` / `<!-- results:end -->`) with
-RESULTS_DIR/summary.md, and copies the plots and renders it links to into the assets
-folder (bench-results/ itself is not committed). Exits 1 when the README has no such
-markers, so that a section is never silently left stale.
+Each section replaces what lies between its two marker lines in the README:
+  bench   RESULTS_DIR/summary.md         between `<!-- bench:begin -->` and `<!-- bench:end -->`
+          (or, failing those, `<!-- results:begin -->` / `<!-- results:end -->`)
+  corpus  RESULTS_DIR/corpus/corpus.md   between `<!-- corpus:begin -->` and `<!-- corpus:end -->`
+A section whose file is missing is skipped (said on stdout) unless it was asked for by
+--sections; the plots and renders a section links to are copied into the assets folder
+(bench-results/ itself is not committed). Exits 1 when the README lacks a section's markers,
+so that a section is never silently left stale.
 """
 import argparse
 import re
@@ -16,8 +20,39 @@ import sys
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
-MARKERS = [("<!-- bench:begin -->", "<!-- bench:end -->"),
-           ("<!-- results:begin -->", "<!-- results:end -->")]
+SECTIONS = {
+    "bench": ("summary.md", [("<!-- bench:begin -->", "<!-- bench:end -->"),
+                             ("<!-- results:begin -->", "<!-- results:end -->")]),
+    "corpus": ("corpus/corpus.md", [("<!-- corpus:begin -->", "<!-- corpus:end -->")]),
+}
+
+
+def replace_section(readme, markers, text):
+    pair = next(((b, e) for b, e in markers if readme.count(b) == 1 and readme.count(e) == 1
+                 and readme.index(b) < readme.index(e)), None)
+    if pair is None:
+        return None
+    begin, end = pair
+    head, rest = readme.split(begin, 1)
+    _, tail = rest.split(end, 1)
+    return f"{head}{begin}\n{text.rstrip()}\n{end}{tail}"
+
+
+def relinked(summary, results, readme_path, assets):
+    """Copies every linked PNG and points the link at the copy, relative to the README."""
+    prefix = Path(*assets.resolve().relative_to(readme_path.resolve().parent).parts)
+
+    def relink(match):
+        target = match.group(2)
+        source = results / target
+        if not source.exists():
+            return match.group(0)
+        dest = assets / target
+        dest.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(source, dest)
+        return f"{match.group(1)}({(prefix / target).as_posix()})"
+
+    return re.sub(r"(\]\s*)\(([^)\s]+\.png)\)", relink, summary)
 
 
 def main():
@@ -26,40 +61,38 @@ def main():
     ap.add_argument("--readme", type=Path, default=ROOT / "README.md")
     ap.add_argument("--assets", type=Path, default=ROOT / "docs" / "bench",
                     help="where the linked PNGs are copied (committed with the README)")
+    ap.add_argument("--sections", default="", help="comma-separated: bench, corpus (default: "
+                    "every section whose file the results folder has)")
     args = ap.parse_args()
 
-    summary_path = args.results / "summary.md"
-    if not summary_path.exists():
-        sys.exit(f"update_readme: {summary_path} is missing: run `make bench` first")
     if not args.readme.exists():
         sys.exit(f"update_readme: {args.readme} does not exist")
+    asked = [s for s in args.sections.split(",") if s]
+    for name in asked:
+        if name not in SECTIONS:
+            sys.exit(f"update_readme: unknown section {name} (known: {', '.join(SECTIONS)})")
     readme = args.readme.read_text()
-    pair = next(((b, e) for b, e in MARKERS if readme.count(b) == 1 and readme.count(e) == 1
-                 and readme.index(b) < readme.index(e)), None)
-    if pair is None:
-        sys.exit(f"update_readme: {args.readme} needs one '{MARKERS[0][0]}' line and, after it, "
-                 f"one '{MARKERS[0][1]}' line around the benchmark section")
-    begin, end = pair
-
-    summary = summary_path.read_text()
-    # Copy every linked PNG and point the link at the copy, relative to the README.
-    prefix = Path(*args.assets.resolve().relative_to(args.readme.resolve().parent).parts)
-
-    def relink(match):
-        target = match.group(2)
-        source = args.results / target
-        if not source.exists():
-            return match.group(0)
-        dest = args.assets / target
-        dest.parent.mkdir(parents=True, exist_ok=True)
-        shutil.copyfile(source, dest)
-        return f"{match.group(1)}({(prefix / target).as_posix()})"
-
-    summary = re.sub(r"(\]\s*)\(([^)\s]+\.png)\)", relink, summary)
-    head, rest = readme.split(begin, 1)
-    _, tail = rest.split(end, 1)
-    args.readme.write_text(f"{head}{begin}\n{summary.rstrip()}\n{end}{tail}")
-    print(f"update_readme: {args.readme} benchmark section regenerated from {summary_path}")
+    done = []
+    for name, (file, markers) in SECTIONS.items():
+        if asked and name not in asked:
+            continue
+        path = args.results / file
+        if not path.exists():
+            if asked:
+                sys.exit(f"update_readme: {path} is missing: run the benchmark first")
+            print(f"update_readme: no {path}: the {name} section is left as it is")
+            continue
+        updated = replace_section(readme, markers, relinked(path.read_text(), path.parent,
+                                                             args.readme, args.assets))
+        if updated is None:
+            sys.exit(f"update_readme: {args.readme} needs one '{markers[0][0]}' line and, after it, "
+                     f"one '{markers[0][1]}' line around the {name} section")
+        readme = updated
+        done.append(f"{name} (from {path})")
+    if not done:
+        sys.exit(f"update_readme: nothing in {args.results}: run `make bench` first")
+    args.readme.write_text(readme)
+    print(f"update_readme: {args.readme}: regenerated " + ", ".join(done))
 
 
 if __name__ == "__main__":

@@ -1,0 +1,87 @@
+"""The benchmark's corpus section judges issue 13's targets per cloud (tests/bench/
+corpus_report.py) and writes its own README section (tests/bench/update_readme.py): both
+checked here on made-up rows, without running anything."""
+import subprocess
+import sys
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(REPO / "tests" / "bench"))
+import corpus  # noqa: E402
+import corpus_report  # noqa: E402
+
+
+def row(cloud, noise=0.0, **gmpu):
+    mesh, variant = cloud.rsplit("_", 1)
+    figures = {"ok": True, "orientation_accuracy": 1.0, "fscore_0.5": 0.99, "fscore_1": 1.0,
+               "components": 1, "genus": [0], "watertight": True, "seconds": 0.3, "wall": 0.4,
+               "noise_estimate": 0.0001}
+    figures.update(gmpu)
+    return {"cloud": cloud, "variant": corpus.variant_of(cloud), "mesh": mesh + ".off",
+            "points": 35000, "noise": noise, "noise_abs": noise * 2.0, "cloud_diagonal": 2.0,
+            "truth": {"components": 1, "genus": [0], "watertight": True}, "gmpu": figures,
+            "poisson_gmpu": {"ok": True, "fscore_0.5": 0.99, "fscore_1": 1.0, "seconds": 2.0},
+            "peer": {"fscore_0.5": 0.98, "fscore_1": 1.0, "seconds": 5.0}}
+
+
+def test_orientation_targets_follow_the_variant():
+    assert corpus_report.checks(row("bear_clean", orientation_accuracy=0.9985))["orientation"] is False
+    assert corpus_report.checks(row("bear_noise1.0", 0.01, orientation_accuracy=0.9985,
+                                    noise_estimate=0.01))["orientation"] is True
+    assert corpus_report.checks(row("bear_sparse1k", orientation_accuracy=0.971))["orientation"] is True
+
+
+def test_fscores_against_the_peer_and_poisson_on_gmpus_normals():
+    c = corpus_report.checks(row("bear_clean", **{"fscore_0.5": 0.986}))
+    assert c["fscore_0.5_peer"] is True       # 0.986 ≥ 0.98
+    assert c["fscore_0.5_poisson"] is True    # 0.986 ≥ 0.99 − 0.005
+    c = corpus_report.checks(row("bear_clean", **{"fscore_0.5": 0.984}))
+    assert c["fscore_0.5_poisson"] is False
+    # peers.tsv keeps 4 decimals: 0.99996 meets a peer's 1.0000
+    assert corpus_report.checks(row("bear_clean", fscore_1=0.99996))["fscore_1_peer"] is True
+
+
+def test_noise_estimate_is_judged_against_the_truths_diagonal():
+    # gmpu's σ̂ is relative to the cloud's diagonal (2.0 here, like the truth's): 1.25 % is
+    # within 30 % of σ = 1 %, 1.35 % is not; on a noise-free cloud the ceiling is 0.05 %.
+    assert corpus_report.checks(row("bear_noise1.0", 0.01, noise_estimate=0.0125))["noise"] is True
+    assert corpus_report.checks(row("bear_noise1.0", 0.01, noise_estimate=0.0135))["noise"] is False
+    r = row("bear_noise1.0", 0.01, noise_estimate=0.0125)
+    r["cloud_diagonal"] = 2.2  # noise widened the cloud: the same σ̂ is 1.375 % of the truth's
+    assert corpus_report.checks(r)["noise"] is False
+    assert corpus_report.checks(row("bear_sparse5k", noise_estimate=0.0006))["noise"] is False
+
+
+def test_thin_walls_need_the_truths_topology_and_open_scans_are_not_judged():
+    r = row("pipe_clean")
+    r["truth"] = {"components": 2, "genus": [1, 1], "watertight": True}
+    assert corpus_report.checks(r)["topology"] is False
+    r["gmpu"].update(components=2, genus=[1, 1])
+    assert corpus_report.checks(r)["topology"] is True
+    assert "topology" not in corpus_report.checks(row("bear_clean"))
+    assert corpus_report.checks(row("mech-holes-shark_noise0.5", 0.005, orientation_accuracy=0.5)) == {}
+
+
+def test_the_section_names_every_target_and_the_peer_source():
+    rows = [row("bear_clean", orientation_accuracy=0.99), row("bear_noise0.5", 0.005, noise_estimate=0.005),
+            row("bear_sparse1k")]
+    text = corpus_report.section({"rows": rows, "peer_source": "reference",
+                                  "ipsr": {"bear_sparse1k": {"fscore_0.5": 0.9, "fscore_1": 0.99,
+                                                             "seconds": 30.0}}}, "a machine")
+    assert "orientation ≥ 99.9 %" in text and "**missed** (met on 2/3; missed: bear_clean)" in text
+    assert "peers.tsv" in text
+    assert "| bear_sparse1k | 0.900 | 0.990 | 30 |" in text and "75× ✗" in text
+
+
+def test_update_readme_rewrites_the_corpus_section_alone(tmp_path):
+    readme = tmp_path / "README.md"
+    readme.write_text("a\n<!-- bench:begin -->\nold bench\n<!-- bench:end -->\n"
+                      "<!-- corpus:begin -->\nold corpus\n<!-- corpus:end -->\nz\n")
+    (tmp_path / "results" / "corpus").mkdir(parents=True)
+    (tmp_path / "results" / "corpus" / "corpus.md").write_text("new corpus\n")
+    done = subprocess.run([sys.executable, str(REPO / "tests" / "bench" / "update_readme.py"),
+                           str(tmp_path / "results"), "--readme", str(readme), "--assets",
+                           str(tmp_path / "assets"), "--sections", "corpus"], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert readme.read_text() == ("a\n<!-- bench:begin -->\nold bench\n<!-- bench:end -->\n"
+                                  "<!-- corpus:begin -->\nnew corpus\n<!-- corpus:end -->\nz\n")
