@@ -667,7 +667,7 @@ static void test_sigterm_during_write_leaves_nothing(void **state) {
     int caught = 0;
     for (int attempt = 0; attempt < 4 && !caught; ++attempt) {
         remove(out);
-        const char *argv[] = {g_cli, in, "-o", out, "--quiet", "--resolution", "160", NULL};
+        const char *argv[] = {g_cli, in, "-o", out, "--quiet", "--resolution", "100", NULL};
         posix_spawn_file_actions_t fa;
         posix_spawn_file_actions_init(&fa);
         posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
