@@ -450,7 +450,8 @@ bool check_ply_header(const char *data, size_t size, const std::string &name) {
     if ((nl || size >= 8) && (!lines.next(first) || first != "ply"))
         fail(GMPU_ERROR_PARSE, name, "not a PLY file (the first line is not 'ply')");
     // Then the whole header, once it is all there.
-    for (const char *p = data; (p = static_cast<const char *>(std::memchr(p, '\n', size - (p - data))));) {
+    for (const char *p = data;
+         (p = static_cast<const char *>(std::memchr(p, '\n', size - static_cast<size_t>(p - data))));) {
         ++p;
         if (static_cast<size_t>(data + size - p) >= 10 && std::memcmp(p, "end_header", 10) == 0) {
             parse_header(data, size, name);
