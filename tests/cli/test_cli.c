@@ -662,9 +662,37 @@ static void test_symlink_and_long_names(void **state) {
     assert_no_staging_left();
 }
 
+/* Runs a reconstruction and sends `sig` the moment a staging file appears; 1 if the signal
+ * killed it mid-write, 0 if the run finished writing first (then the caller retries). */
+static int kill_during_write(const char *in, const char *out, int sig) {
+    const char *argv[] = {g_cli, in, "-o", out, "--quiet", "--resolution", "100", NULL};
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
+    posix_spawn_file_actions_addopen(&fa, 2, "/dev/null", O_WRONLY, 0);
+    pid_t pid;
+    assert_int_equal(posix_spawn(&pid, g_cli, &fa, NULL, (char *const *)argv, environ), 0);
+    posix_spawn_file_actions_destroy(&fa);
+    int ws = 0, done = 0;
+    while (!done) {
+        if (staging_in(scratch_dir)) {
+            kill(pid, sig);
+            break;
+        }
+        done = waitpid(pid, &ws, WNOHANG) == pid;
+        usleep(200);
+    }
+    if (!done) waitpid(pid, &ws, 0);
+    if (!WIFSIGNALED(ws)) {
+        assert_int_equal(WEXITSTATUS(ws), 0);
+        return 0;
+    }
+    assert_int_equal(WTERMSIG(ws), sig);
+    return 1;
+}
+
 /* SIGTERM while the mesh is being written: the process dies of it and leaves neither the
- * output nor a staging file or temporary beside it. The signal is sent the moment a
- * staging file appears; a run that finished writing first is retried. */
+ * output nor a staging file or temporary beside it. */
 static void test_sigterm_during_write_leaves_nothing(void **state) {
     (void)state;
     const char *in = scratch_path("keep-sphere.xyz");
@@ -673,35 +701,42 @@ static void test_sigterm_during_write_leaves_nothing(void **state) {
     int caught = 0;
     for (int attempt = 0; attempt < 4 && !caught; ++attempt) {
         remove(out);
-        const char *argv[] = {g_cli, in, "-o", out, "--quiet", "--resolution", "100", NULL};
-        posix_spawn_file_actions_t fa;
-        posix_spawn_file_actions_init(&fa);
-        posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
-        posix_spawn_file_actions_addopen(&fa, 2, "/dev/null", O_WRONLY, 0);
-        pid_t pid;
-        assert_int_equal(posix_spawn(&pid, g_cli, &fa, NULL, (char *const *)argv, environ), 0);
-        posix_spawn_file_actions_destroy(&fa);
-        int ws = 0, done = 0;
-        while (!done) {
-            if (staging_in(scratch_dir)) {
-                kill(pid, SIGTERM);
-                break;
-            }
-            done = waitpid(pid, &ws, WNOHANG) == pid;
-            usleep(200);
-        }
-        if (!done) waitpid(pid, &ws, 0);
-        if (WIFSIGNALED(ws)) {
-            assert_int_equal(WTERMSIG(ws), SIGTERM);
-            caught = 1;
-            assert_false(exists(out));
-        } else {
-            assert_int_equal(WEXITSTATUS(ws), 0);
-        }
+        caught = kill_during_write(in, out, SIGTERM);
+        if (caught) assert_false(exists(out));
         assert_false(staging_in(scratch_dir));
         remove(out);
     }
     if (!caught) fail_msg("the write never outlasted the polling: SIGTERM was not tested");
+}
+
+/* SIGKILL cannot be caught: its staging files stay. The next run ignores them (fresh names,
+ * never theirs) and leaves them alone: they are not its files. */
+static void test_leftovers_of_a_killed_run_are_ignored(void **state) {
+    (void)state;
+    const char *in = scratch_path("keep-sphere.xyz");
+    put_xyz(in, g_sphere, N_SPHERE);
+    const char *out = scratch_path("killed.obj");
+    int caught = 0;
+    for (int attempt = 0; attempt < 4 && !caught; ++attempt) {
+        remove(out);
+        caught = kill_during_write(in, out, SIGKILL);
+    }
+    if (!caught) fail_msg("the write never outlasted the polling: SIGKILL was not tested");
+    assert_true(staging_in(scratch_dir));
+    const int left = scratch_count(scratch_dir, "killed.obj.");
+    assert_true(left >= 1);
+    const char *args[] = {in, "-o", out, "--normals-out", scratch_path("killed.obj.xyz"), "--quiet", "--resolution",
+                          "24", NULL};
+    run_result r = run_cli(args);
+    check_run(&r, 0, NULL);
+    assert_true(exists(out));
+    assert_int_equal(scratch_count(scratch_dir, "killed.obj."), left + 1); /* + the points file */
+    /* Clean up what the killed run left. */
+    DIR *d = opendir(scratch_dir);
+    struct dirent *e;
+    while (d && (e = readdir(d)) != NULL)
+        if (strncmp(e->d_name, "killed.", 7) == 0) remove(scratch_path(e->d_name));
+    if (d) closedir(d);
     assert_no_staging_left();
 }
 
@@ -720,6 +755,7 @@ int main(void) {
         cmocka_unit_test(test_option_syntax),
         cmocka_unit_test(test_symlink_and_long_names),
         cmocka_unit_test(test_sigterm_during_write_leaves_nothing),
+        cmocka_unit_test(test_leftovers_of_a_killed_run_are_ignored),
     };
     return cmocka_run_group_tests(tests, group_setup, group_teardown);
 }
