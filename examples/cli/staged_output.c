@@ -218,9 +218,9 @@ int output_stage(staged_output *out, char *msg, size_t msg_size) {
     const char *base = out->target + (slash - dir) + 1;
     *slash = '\0';
     if (!dir[0]) strcpy(dir, "/");
-    char ext[16];
-    extension_of(base, ext, sizeof ext);
-    const char *dot = strrchr(base, '.'); /* the extension as written: the format follows it */
+    /* The extension the user wrote: it picks the format, even when a symlink's target is
+     * named otherwise. */
+    const char *dot = strrchr(out->given, '.');
 
     sigset_t old;
     block_signals(&old);

@@ -646,6 +646,16 @@ static void test_symlink_and_long_names(void **state) {
     check_off_sphere(target, c, 1.0, 0.05);
     assert_int_equal(scratch_count(dir, ""), 1);
     assert_false(staging_in(dir));
+    /* The format follows the name written on the command line, not the link target's. */
+    const char *data = scratch_path("keep-real/mesh.data");
+    put_text(data, "old");
+    const char *link2 = scratch_path("keep-link2.off");
+    assert_int_equal(symlink("keep-real/mesh.data", link2), 0);
+    const char *a1b[] = {in, "-o", link2, "--quiet", "--resolution", "24", NULL};
+    r = run_cli(a1b);
+    check_run(&r, 0, NULL);
+    check_off_sphere(data, c, 1.0, 0.05);
+    assert_int_equal(scratch_count(dir, ""), 2);
 
     char name[260];
     memset(name, 'n', 247);
