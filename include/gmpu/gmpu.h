@@ -309,9 +309,11 @@ GMPU_API gmpu_status gmpu_mesh_write(const gmpu_mesh *mesh, const char *path);
 
 /* Reads a point cloud: .ply (ascii, binary little or big endian; x y z and optional
  * nx ny nz; other properties and elements skipped), .xyz / .txt (3 or 6 columns),
- * .off and .obj (vertices only). Errors: INVALID_ARGUMENT, IO (missing, unreadable or a
- * directory), PARSE (malformed, truncated or lying header; the message gives the line or
- * element), UNSUPPORTED (extension or PLY variant), INVALID_INPUT (no points). */
+ * .off and .obj (vertices only). Only regular files are read: a FIFO, a device or a
+ * directory fails at once. Errors: INVALID_ARGUMENT, IO (missing, unreadable, not a regular
+ * file), PARSE (malformed, truncated or lying header, not the format its extension says;
+ * the message gives the line or element), UNSUPPORTED (extension or PLY variant),
+ * INVALID_INPUT (no points). */
 GMPU_API gmpu_status gmpu_points_read(const char *path, gmpu_points **out);
 
 /* Builds a point set from caller arrays (copied); normals may be NULL. */

@@ -1,6 +1,7 @@
 // The per-format readers and writers behind io.hpp. Readers parse an in-memory buffer
-// (`name` is only used in messages), so the fuzz targets in tests/fuzz call them directly
-// and the file readers are a thin read-whole-file wrapper around them.
+// (`name` is only used in messages), so the fuzz targets in tests/fuzz call them directly.
+// The file readers (format_dispatch.cpp) give the line-based formats a LineReader over the
+// file read in chunks, and PLY its bytes once its header has been checked.
 #pragma once
 
 #include <cstddef>
