@@ -789,6 +789,29 @@ void test_text_arrays_sized_once(void **) {
     }
 }
 
+// A symlink as the output is written through: its target gets the bytes, the link stays
+// (relative links resolve from the link's directory; a chain is followed to its end).
+void test_write_through_symlinks(void **) {
+    const std::string dir = fresh_dir("links");
+    const double v[] = {1, 2, 3};
+    assert_int_equal(::mkdir((dir + "/real").c_str(), 0755), 0);
+    std::ofstream(dir + "/real/cloud.xyz") << "old\n";
+    assert_int_equal(::symlink("real/cloud.xyz", (dir + "/link1.xyz").c_str()), 0);
+    assert_int_equal(::symlink("link1.xyz", (dir + "/link2.xyz").c_str()), 0);
+    gmpu::io::write_points(dir + "/link2.xyz", v, nullptr, 1);
+    assert_string_equal(slurp(dir + "/real/cloud.xyz").c_str(), "1 2 3\n");
+    struct stat st;
+    for (const char *link : {"/link1.xyz", "/link2.xyz"}) {
+        assert_int_equal(::lstat((dir + link).c_str(), &st), 0);
+        assert_true(S_ISLNK(st.st_mode));
+    }
+    assert_int_equal(entries(dir + "/real").size(), 1);
+    assert_int_equal(::symlink("loop.xyz", (dir + "/loop.xyz").c_str()), 0);
+    expect_error([&] { gmpu::io::write_points(dir + "/loop.xyz", v, nullptr, 1); }, GMPU_ERROR_IO,
+                 {"loop.xyz", "symbolic links"});
+    assert_int_equal(entries(dir).size(), 4);  // real, link1, link2, loop: nothing else
+}
+
 // A leftover temporary of a killed run with our pid (or any run of them) does not stop a
 // write; a 251-character name (legal) gets a temporary that fits NAME_MAX.
 void test_write_temporaries_fit_and_skip_leftovers(void **) {
@@ -903,6 +926,7 @@ int main(void) {
         cmocka_unit_test(test_utf8_bom_is_skipped),
         cmocka_unit_test(test_text_arrays_sized_once),
         cmocka_unit_test(test_write_temporaries_fit_and_skip_leftovers),
+        cmocka_unit_test(test_write_through_symlinks),
         cmocka_unit_test(test_buffer_parsers),
         cmocka_unit_test(test_shared_clouds),
         cmocka_unit_test(test_shared_mesh_and_scan),
