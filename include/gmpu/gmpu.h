@@ -301,7 +301,8 @@ GMPU_API const uint32_t *gmpu_mesh_triangles(const gmpu_mesh *mesh);
 
 /* Writes the mesh; the format comes from the extension: .ply (binary little-endian),
  * .obj, .off. The file is written beside the target under a temporary name and renamed,
- * so a failure never leaves a partial file. Errors: INVALID_ARGUMENT, UNSUPPORTED
+ * so a failure never leaves a partial file. A symlink as path is written through: the file
+ * it points to is replaced, the link stays. Errors: INVALID_ARGUMENT, UNSUPPORTED
  * (extension), IO (with the system's reason). */
 GMPU_API gmpu_status gmpu_mesh_write(const gmpu_mesh *mesh, const char *path);
 
