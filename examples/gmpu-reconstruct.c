@@ -4,13 +4,15 @@
  *
  *   gmpu-reconstruct INPUT -o OUTPUT [--normals-out POINTS.ply] [--error E]
  *                    [--max-depth D] [--resolution R] [--level L] [--threads T]
- *                    [--use-normals] [--sharp] [--quiet]
+ *                    [--use-normals] [--sharp] [--quiet] [--version]
  *
  * Output format from the extension (.ply, .obj, .off). Exit status 0 on success, 1 on a
- * failure (one line on stderr), 2 on bad usage.
+ * failure (one line on stderr), 2 on bad usage. The outputs are checked before any work
+ * and replaced only once all of them are written (cli/staged_output.h).
  */
-#define _POSIX_C_SOURCE 200809L
+#define _GNU_SOURCE /* getopt_long */
 #include <errno.h>
+#include <getopt.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -18,6 +20,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "cli/staged_output.h"
 #include "gmpu/gmpu.h"
 
 typedef struct {
@@ -29,9 +32,11 @@ typedef struct {
 static const char *usage =
     "usage: gmpu-reconstruct INPUT -o OUTPUT [--normals-out POINTS.ply] [--error E]\n"
     "                        [--max-depth D] [--resolution R] [--level L] [--threads T]\n"
-    "                        [--use-normals] [--sharp] [--quiet]\n"
+    "                        [--use-normals] [--sharp] [--quiet] [--version]\n"
     "  INPUT   .ply .xyz .txt .off .obj point cloud (normals ignored unless --use-normals)\n"
-    "  OUTPUT  .ply .obj .off mesh (closed, outward-facing)\n";
+    "  OUTPUT  .ply .obj .off mesh (closed, outward-facing)\n"
+    "  Options take their value as the next argument or after '=' (--resolution=64).\n"
+    "  A file name starting with '-' must be written ./-name.\n";
 
 static int parse_number(const char *flag, const char *text, double *out) {
     char *end = NULL;
@@ -45,53 +50,99 @@ static int parse_number(const char *flag, const char *text, double *out) {
     return 1;
 }
 
+/* A file name option's value: never another option ("-o --threads 4" is a mistake, not an
+ * output called "--threads"). */
+static int parse_path(const char *flag, const char *text, const char **out) {
+    if (text[0] == '-') {
+        fprintf(stderr, "gmpu-reconstruct: %s needs a file name, got '%s'\n%s", flag, text, usage);
+        return 0;
+    }
+    *out = text;
+    return 1;
+}
+
+enum { OPT_NORMALS_OUT = 256, OPT_ERROR, OPT_MAX_DEPTH, OPT_RESOLUTION, OPT_LEVEL, OPT_THREADS, OPT_USE_NORMALS,
+       OPT_SHARP };
+
+static const struct option long_options[] = {
+    {"output", required_argument, NULL, 'o'},
+    {"normals-out", required_argument, NULL, OPT_NORMALS_OUT},
+    {"error", required_argument, NULL, OPT_ERROR},
+    {"max-depth", required_argument, NULL, OPT_MAX_DEPTH},
+    {"resolution", required_argument, NULL, OPT_RESOLUTION},
+    {"level", required_argument, NULL, OPT_LEVEL},
+    {"threads", required_argument, NULL, OPT_THREADS},
+    {"use-normals", no_argument, NULL, OPT_USE_NORMALS},
+    {"sharp", no_argument, NULL, OPT_SHARP},
+    {"quiet", no_argument, NULL, 'q'},
+    {"help", no_argument, NULL, 'h'},
+    {"version", no_argument, NULL, 'V'},
+    {NULL, 0, NULL, 0},
+};
+
+static int positional(options *o, const char *a) {
+    if (!o->input) {
+        o->input = a;
+        return 1;
+    }
+    fprintf(stderr, "gmpu-reconstruct: unexpected argument '%s'\n%s", a, usage);
+    return 0;
+}
+
 static int parse_args(int argc, char **argv, options *o) {
     memset(o, 0, sizeof *o);
     /* NAN: not given (a negative value is given, and must reach the library's range check). */
     o->error = o->max_depth = o->resolution = o->level = o->threads = NAN;
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i];
-        const char *next = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(a, "-h") || !strcmp(a, "--help")) {
-            fputs(usage, stdout);
-            exit(0);
-        } else if (!strcmp(a, "-o") || !strcmp(a, "--output")) {
-            if (!next) break;
-            o->output = argv[++i];
-        } else if (!strcmp(a, "--normals-out")) {
-            if (!next) break;
-            o->normals_out = argv[++i];
-        } else if (!strcmp(a, "--error")) {
-            if (!parse_number(a, next, &o->error)) return 0;
-            ++i;
-        } else if (!strcmp(a, "--max-depth")) {
-            if (!parse_number(a, next, &o->max_depth)) return 0;
-            ++i;
-        } else if (!strcmp(a, "--resolution")) {
-            if (!parse_number(a, next, &o->resolution)) return 0;
-            ++i;
-        } else if (!strcmp(a, "--level")) {
-            if (!parse_number(a, next, &o->level)) return 0;
-            ++i;
-        } else if (!strcmp(a, "--threads")) {
-            if (!parse_number(a, next, &o->threads)) return 0;
-            ++i;
-        } else if (!strcmp(a, "--use-normals")) {
-            o->use_normals = 1;
-        } else if (!strcmp(a, "--sharp")) {
-            o->sharp = 1;
-        } else if (!strcmp(a, "--quiet") || !strcmp(a, "-q")) {
-            o->quiet = 1;
-        } else if (a[0] == '-' && a[1] != '\0') {
-            fprintf(stderr, "gmpu-reconstruct: unknown option '%s'\n%s", a, usage);
-            return 0;
-        } else if (!o->input) {
-            o->input = a;
-        } else {
-            fprintf(stderr, "gmpu-reconstruct: unexpected argument '%s'\n%s", a, usage);
-            return 0;
+    opterr = 0; /* our own messages, one line each */
+    optind = 1;
+    /* "-": non-options come back in order (code 1), whatever POSIXLY_CORRECT says; ":": a
+     * missing value is reported as ':' rather than '?'. */
+    int c, index = -1;
+    while ((c = getopt_long(argc, argv, "-:o:qhV", long_options, &index)) != -1) {
+        /* The option as the user wrote it, for messages: -o is the only short one with a value. */
+        char flag[64] = "-o";
+        if (index >= 0) snprintf(flag, sizeof flag, "--%s", long_options[index].name);
+        index = -1;
+        switch (c) {
+            case 1:
+                if (!positional(o, optarg)) return 0;
+                break;
+            case 'h': fputs(usage, stdout); exit(0);
+            case 'V':
+                printf("gmpu-reconstruct %d.%d.%d (library %s, ABI %u)\n", GMPU_VERSION_MAJOR, GMPU_VERSION_MINOR,
+                       GMPU_VERSION_PATCH, gmpu_version_string(), (unsigned)gmpu_abi_version());
+                exit(0);
+            case 'o':
+                if (!parse_path(flag, optarg, &o->output)) return 0;
+                break;
+            case OPT_NORMALS_OUT:
+                if (!parse_path(flag, optarg, &o->normals_out)) return 0;
+                break;
+            case OPT_ERROR: if (!parse_number(flag, optarg, &o->error)) return 0; break;
+            case OPT_MAX_DEPTH: if (!parse_number(flag, optarg, &o->max_depth)) return 0; break;
+            case OPT_RESOLUTION: if (!parse_number(flag, optarg, &o->resolution)) return 0; break;
+            case OPT_LEVEL: if (!parse_number(flag, optarg, &o->level)) return 0; break;
+            case OPT_THREADS: if (!parse_number(flag, optarg, &o->threads)) return 0; break;
+            case OPT_USE_NORMALS: o->use_normals = 1; break;
+            case OPT_SHARP: o->sharp = 1; break;
+            case 'q': o->quiet = 1; break;
+            case ':': {
+                const char *what = argv[optind - 1];
+                if (optopt == 'o') {
+                    fprintf(stderr, "gmpu-reconstruct: missing -o OUTPUT\n%s", usage);
+                } else {
+                    fprintf(stderr, "gmpu-reconstruct: %s needs a %s\n%s", what,
+                            optopt == OPT_NORMALS_OUT ? "file name" : "number", usage);
+                }
+                return 0;
+            }
+            default:
+                fprintf(stderr, "gmpu-reconstruct: unknown option '%s'\n%s", argv[optind - 1], usage);
+                return 0;
         }
     }
+    for (; optind < argc; ++optind) /* after "--" */
+        if (!positional(o, argv[optind])) return 0;
     if (!o->input || !o->output) {
         fprintf(stderr, "gmpu-reconstruct: %s\n%s", !o->input ? "missing INPUT" : "missing -o OUTPUT", usage);
         return 0;
@@ -152,9 +203,72 @@ static int set(gmpu_surface *s, gmpu_param key, double value) {
     return isnan(value) || gmpu_surface_set_param(s, key, value) == GMPU_OK;
 }
 
+/* Writes the mesh and the oriented points to their staging files, then moves both into
+ * place: a failure anywhere leaves every target as it was. */
+static int write_outputs(gmpu_mesh **mesh, gmpu_surface **surface, const gmpu_points *cloud, staged_output *mesh_out,
+                         staged_output *points_out) {
+    char msg[PATH_MAX + 256];
+    const size_t n = gmpu_points_count(cloud);
+    if (!output_stage(mesh_out, msg, sizeof msg)) goto failed;
+    if (gmpu_mesh_write(*mesh, mesh_out->staging) != GMPU_OK) {
+        output_discard(mesh_out);
+        return fail("cannot write mesh");
+    }
+    /* Written: free it before the oriented points need their memory (peak matters at 1M). */
+    gmpu_mesh_destroy(*mesh);
+    *mesh = NULL;
+    if (points_out) {
+        if (!output_stage(points_out, msg, sizeof msg)) goto failed;
+        double *normals = malloc(3 * n * sizeof *normals);
+        gmpu_points *oriented = NULL;
+        int ok = normals && gmpu_surface_copy_normals(*surface, normals, n) == GMPU_OK;
+        /* Its normals copied, the surface is done: free it before the copy below (at a
+         * million points, the two together would set the peak). */
+        gmpu_surface_destroy(*surface);
+        *surface = NULL;
+        ok = ok && gmpu_points_create(gmpu_points_positions(cloud), normals, n, &oriented) == GMPU_OK;
+        free(normals);
+        ok = ok && gmpu_points_write(oriented, points_out->staging) == GMPU_OK;
+        gmpu_points_destroy(oriented);
+        if (!ok) {
+            output_discard(points_out);
+            output_discard(mesh_out);
+            return fail("cannot write oriented points");
+        }
+    }
+    if (!output_commit(mesh_out, msg, sizeof msg)) goto failed;
+    if (points_out && !output_commit(points_out, msg, sizeof msg)) goto failed;
+    return 0;
+failed:
+    output_discard(mesh_out);
+    if (points_out) output_discard(points_out);
+    fprintf(stderr, "gmpu-reconstruct: %s\n", msg);
+    return 1;
+}
+
+/* Every output checked before any work: a bad path fails in milliseconds, not after the
+ * reconstruction, and nothing the user did not ask to replace can be. */
+static int prepare_outputs(const options *o, staged_output *mesh_out, staged_output *points_out) {
+    char msg[PATH_MAX + 256];
+    if (!output_prepare(mesh_out, o->output, OUTPUT_MESH, o->input, msg, sizeof msg) ||
+        (o->normals_out && !output_prepare(points_out, o->normals_out, OUTPUT_POINTS, o->input, msg, sizeof msg))) {
+        fprintf(stderr, "gmpu-reconstruct: %s\n", msg);
+        return 0;
+    }
+    if (o->normals_out && output_same_target(mesh_out, points_out)) {
+        fprintf(stderr, "gmpu-reconstruct: -o %s and --normals-out %s are the same file\n", o->output,
+                o->normals_out);
+        return 0;
+    }
+    return 1;
+}
+
 int main(int argc, char **argv) {
     options o;
     if (!parse_args(argc, argv, &o)) return 2;
+    staged_output mesh_out, points_out;
+    if (!prepare_outputs(&o, &mesh_out, &points_out)) return 1;
+    output_install_signal_cleanup();
 
     progress_state prog = {isatty(STDERR_FILENO), o.quiet, 0, -1};
     double t_start = now_seconds();
@@ -195,36 +309,15 @@ int main(int argc, char **argv) {
     if (gmpu_surface_orient(surface) != GMPU_OK) { rc = fail("orient failed"); goto done; }
     if (gmpu_surface_polygonize(surface, &mesh) != GMPU_OK) { rc = fail("polygonize failed"); goto done; }
     double t_write = now_seconds();
-    if (gmpu_mesh_write(mesh, o.output) != GMPU_OK) { rc = fail("cannot write mesh"); goto done; }
-    /* Written: free it before the oriented points need their memory (peak matters at 1M). */
     mesh_vertices = gmpu_mesh_vertex_count(mesh);
     mesh_triangles = gmpu_mesh_triangle_count(mesh);
-    gmpu_mesh_destroy(mesh);
-    mesh = NULL;
     /* The summary's figures, read now: writing the oriented points frees the surface. */
     const gmpu_stat keys[] = {GMPU_STAT_CELLS, GMPU_STAT_LEAVES, GMPU_STAT_DEPTH, GMPU_STAT_COMPONENTS,
                               GMPU_STAT_NOISE, GMPU_STAT_EFFECTIVE_ERROR, GMPU_STAT_FIT_SECONDS,
                               GMPU_STAT_ORIENT_SECONDS, GMPU_STAT_POLYGONIZE_SECONDS, GMPU_STAT_RESOLUTION};
     stat_count = (int)(sizeof keys / sizeof keys[0]);
     for (int k = 0; k < stat_count; ++k) gmpu_surface_get_stat(surface, keys[k], &stat[k]);
-    if (o.normals_out) {
-        double *normals = malloc(3 * n * sizeof *normals);
-        gmpu_points *oriented = NULL;
-        int ok = normals && gmpu_surface_copy_normals(surface, normals, n) == GMPU_OK;
-        /* Its normals copied, the surface is done: free it before the copy below (at a
-         * million points, the two together would set the peak). */
-        gmpu_surface_destroy(surface);
-        surface = NULL;
-        ok = ok && gmpu_points_create(gmpu_points_positions(cloud), normals, n, &oriented) == GMPU_OK;
-        free(normals);
-        ok = ok && gmpu_points_write(oriented, o.normals_out) == GMPU_OK;
-        gmpu_points_destroy(oriented);
-        if (!ok) {
-            remove(o.output); /* all or nothing: no mesh without the normals asked for */
-            rc = fail("cannot write oriented points");
-            goto done;
-        }
-    }
+    if (write_outputs(&mesh, &surface, cloud, &mesh_out, o.normals_out ? &points_out : NULL) != 0) goto done;
     double t_end = now_seconds();
 
     if (!o.quiet) {

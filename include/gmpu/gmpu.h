@@ -310,7 +310,8 @@ GMPU_API const uint32_t *gmpu_mesh_triangles(const gmpu_mesh *mesh);
 
 /* Writes the mesh; the format comes from the extension: .ply (binary little-endian),
  * .obj, .off. The file is written beside the target under a temporary name and renamed,
- * so a failure never leaves a partial file. Errors: INVALID_ARGUMENT, UNSUPPORTED
+ * so a failure never leaves a partial file. A symlink as path is written through: the file
+ * it points to is replaced, the link stays. Errors: INVALID_ARGUMENT, UNSUPPORTED
  * (extension), IO (with the system's reason). */
 GMPU_API gmpu_status gmpu_mesh_write(const gmpu_mesh *mesh, const char *path);
 
@@ -318,9 +319,11 @@ GMPU_API gmpu_status gmpu_mesh_write(const gmpu_mesh *mesh, const char *path);
 
 /* Reads a point cloud: .ply (ascii, binary little or big endian; x y z and optional
  * nx ny nz; other properties and elements skipped), .xyz / .txt (3 or 6 columns),
- * .off and .obj (vertices only). Errors: INVALID_ARGUMENT, IO (missing, unreadable or a
- * directory), PARSE (malformed, truncated or lying header; the message gives the line or
- * element), UNSUPPORTED (extension or PLY variant), INVALID_INPUT (no points). */
+ * .off and .obj (vertices only). Only regular files are read: a FIFO, a device or a
+ * directory fails at once. Errors: INVALID_ARGUMENT, IO (missing, unreadable, not a regular
+ * file), PARSE (malformed, truncated or lying header, not the format its extension says;
+ * the message gives the line or element), UNSUPPORTED (extension or PLY variant),
+ * INVALID_INPUT (no points). */
 GMPU_API gmpu_status gmpu_points_read(const char *path, gmpu_points **out);
 
 /* Builds a point set from caller arrays (copied); normals may be NULL. */

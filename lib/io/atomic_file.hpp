@@ -1,7 +1,8 @@
 // All-or-nothing file writes: the bytes go to a temporary file beside the target, which is
 // renamed over the target only once everything was written and closed. On any failure (or
 // if commit() is never reached, e.g. an exception unwinds) the temporary is removed, so
-// the target is either untouched or complete. No fsync: the guarantee is against our
+// the target is either untouched or complete. A symlink as target is written through: the
+// file it points to is replaced and the link stays. No fsync: the guarantee is against our
 // own failures (ENOSPC, EIO, exceptions), not against a power cut.
 #pragma once
 
@@ -30,7 +31,8 @@ private:
     void flush();
     [[noreturn]] void fail_io(const char *doing, int err);
 
-    std::string path_;
+    std::string path_;    // as given (messages)
+    std::string target_;  // what is replaced: path_ with symlinks followed
     std::string temp_;
     int fd_ = -1;
     std::vector<char> buffer_;

@@ -1,5 +1,5 @@
-// The public entry points of io.hpp: pick the format from the extension, read the whole
-// file and parse it, check the values; or validate, write through AtomicFile and commit.
+// The public entry points of io.hpp: pick the format from the extension, open the file
+// (a regular file, or an IO error), parse it, check the values; or validate, write through AtomicFile and commit.
 #include <cctype>
 #include <climits>
 #include <cmath>
@@ -7,8 +7,8 @@
 
 #include "io/atomic_file.hpp"
 #include "io/errors.hpp"
-#include "io/file_bytes.hpp"
 #include "io/formats.hpp"
+#include "io/input_file.hpp"
 #include "io/io.hpp"
 
 namespace gmpu::io {
@@ -51,12 +51,43 @@ Format format_of(const std::string &path, const Accepts &a) {
              a.purpose + " (expected " + a.list + ")");
 }
 
-Parsed parse(Format f, const std::string &bytes, const std::string &path, Want want) {
+// PLY: its header first, checked, and only then the body (read whole: binary bodies are
+// parsed in place). A 2 GB file that is not a PLY fails on its first bytes.
+std::string read_ply_bytes(InputFile &file, const std::string &path) {
+    std::string bytes;
+    size_t want = size_t{64} << 10;
+    for (;;) {
+        const size_t had = bytes.size();
+        bytes.resize(had + want);
+        size_t got = had;
+        while (got < bytes.size()) {
+            const size_t n = file.read(&bytes[got], bytes.size() - got);
+            if (n == 0) break;
+            got += n;
+        }
+        const bool at_end = got < bytes.size();
+        bytes.resize(got);
+        if (check_ply_header(bytes.data(), bytes.size(), path) || at_end) break;
+        want = bytes.size();  // doubling: a long header is scanned a bounded number of times
+    }
+    file.read_rest(bytes);
+    return bytes;
+}
+
+Parsed parse(Format f, InputFile &file, const std::string &path, Want want) {
+    if (f == Format::ply) {
+        const std::string bytes = read_ply_bytes(file, path);
+        return parse_ply_buffer(bytes.data(), bytes.size(), path, want);
+    }
+    // Text formats: read in chunks, the arrays sized once from a count of the lines, so a
+    // text file costs the memory of its numbers, not of its bytes as well.
+    const uint64_t line_count = f == Format::off ? 0 : count_lines(file, path);
+    LineReader lines(file, path);
     switch (f) {
-        case Format::ply: return parse_ply_buffer(bytes.data(), bytes.size(), path, want);
-        case Format::xyz: return parse_xyz_buffer(bytes.data(), bytes.size(), path);
-        case Format::off: return parse_off_buffer(bytes.data(), bytes.size(), path, want);
-        case Format::obj: return parse_obj_buffer(bytes.data(), bytes.size(), path, want);
+        case Format::xyz: return parse_xyz_lines(lines, path, line_count);
+        case Format::off: return parse_off_lines(lines, path, want);
+        case Format::obj: return parse_obj_lines(lines, path, want, line_count);
+        case Format::ply: break;
     }
     fail(GMPU_ERROR_INTERNAL, path, "unknown format");
 }
@@ -87,8 +118,8 @@ using detail::fail;
 
 PointCloud read_points(const std::string &path) {
     const detail::Format f = detail::format_of(path, detail::reading_points);
-    const std::string bytes = detail::read_file_bytes(path);
-    detail::Parsed parsed = detail::parse(f, bytes, path, detail::Want::points);
+    detail::InputFile file(path);
+    detail::Parsed parsed = detail::parse(f, file, path, detail::Want::points);
     detail::check_points(parsed, path);
     PointCloud cloud;
     cloud.positions = std::move(parsed.positions);
@@ -98,8 +129,8 @@ PointCloud read_points(const std::string &path) {
 
 MeshData read_mesh(const std::string &path) {
     const detail::Format f = detail::format_of(path, detail::reading_meshes);
-    const std::string bytes = detail::read_file_bytes(path);
-    detail::Parsed parsed = detail::parse(f, bytes, path, detail::Want::mesh);
+    detail::InputFile file(path);
+    detail::Parsed parsed = detail::parse(f, file, path, detail::Want::mesh);
     detail::check_mesh(parsed, path);
     MeshData mesh;
     mesh.vertices = std::move(parsed.positions);

@@ -1,6 +1,7 @@
 // The per-format readers and writers behind io.hpp. Readers parse an in-memory buffer
-// (`name` is only used in messages), so the fuzz targets in tests/fuzz call them directly
-// and the file readers are a thin read-whole-file wrapper around them.
+// (`name` is only used in messages), so the fuzz targets in tests/fuzz call them directly.
+// The file readers (format_dispatch.cpp) give the line-based formats a LineReader over the
+// file read in chunks, and PLY its bytes once its header has been checked.
 #pragma once
 
 #include <cstddef>
@@ -30,6 +31,18 @@ Parsed parse_ply_buffer(const char *data, size_t size, const std::string &name, 
 Parsed parse_xyz_buffer(const char *data, size_t size, const std::string &name);
 Parsed parse_off_buffer(const char *data, size_t size, const std::string &name, Want want);
 Parsed parse_obj_buffer(const char *data, size_t size, const std::string &name, Want want);
+
+// The line-based formats from a LineReader (a buffer, or a file read in chunks);
+// line_count (an upper bound on the vertices, 0 if unknown) sizes the arrays once.
+class LineReader;
+Parsed parse_xyz_lines(LineReader &lines, const std::string &name, uint64_t line_count);
+Parsed parse_off_lines(LineReader &lines, const std::string &name, Want want);
+Parsed parse_obj_lines(LineReader &lines, const std::string &name, Want want, uint64_t line_count);
+
+// PLY: the header alone, checked (GMPU_ERROR_PARSE / UNSUPPORTED as parse_ply_buffer), so
+// that a file that is not a PLY fails before its body is read. `data` must hold the whole
+// header; true if it does (an "end_header" line was found).
+bool check_ply_header(const char *data, size_t size, const std::string &name);
 
 // INVALID_INPUT for a non-finite coordinate or normal (naming the vertex index) and for
 // an empty result ("no points" / "no vertices").

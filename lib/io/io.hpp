@@ -36,7 +36,8 @@ struct MeshView {
 // .off, .obj (vertices only). Format chosen by extension, case-insensitive.
 //
 // Which failure is which (every message starts with the path):
-//   IO            the file is missing, unreadable or a directory (with the system's reason);
+//   IO            the file is missing, unreadable, a directory or not a regular file (a FIFO,
+//                 a device: refused before reading), with the system's reason;
 //   UNSUPPORTED   the extension, a PLY format/version/property type, 4OFF/nOFF, binary OFF;
 //   PARSE         bad syntax, a token that is not entirely a number ("1.0abc") or is beyond
 //                 the double range ("1e999"), a header count the file does not hold

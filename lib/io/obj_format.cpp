@@ -14,8 +14,16 @@
 namespace gmpu::io::detail {
 
 Parsed parse_obj_buffer(const char *data, size_t size, const std::string &name, Want want) {
+    LineReader lines(data, data + size, name);
+    return parse_obj_lines(lines, name, want, 0);
+}
+
+Parsed parse_obj_lines(LineReader &lines, const std::string &name, Want want, uint64_t line_count) {
     Parsed out;
-    LineReader lines(data, data + size);
+    // Every line may be a vertex: the bound reserves address space that the faces, normals
+    // and texture lines of a mesh never touch (so it costs no memory), and no vertex ever
+    // makes the array grow by copying.
+    out.positions.reserve(3 * line_count);
     std::string_view line, tok;
     std::vector<uint32_t> polygon;
     while (lines.next(line)) {

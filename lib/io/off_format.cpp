@@ -22,7 +22,7 @@ namespace {
 // Lines with their comments removed; blank ones skipped.
 class ContentLines {
 public:
-    ContentLines(const char *data, size_t size) : lines_(data, data + size) {}
+    explicit ContentLines(LineReader &lines) : lines_(lines) {}
     bool next(std::string_view &line) {
         while (lines_.next(line)) {
             line = line.substr(0, line.find('#'));
@@ -31,10 +31,10 @@ public:
         return false;
     }
     std::string at() const { return "line " + std::to_string(lines_.line_number()) + ": "; }
-    size_t remaining() const { return lines_.remaining(); }
+    uint64_t remaining() const { return lines_.remaining(); }
 
 private:
-    LineReader lines_;
+    LineReader &lines_;
 };
 
 // Whether the header keyword names a variant we read, and whether it has normals.
@@ -60,7 +60,12 @@ uint64_t count_token(std::string_view tok, const ContentLines &lines, const std:
 }  // namespace
 
 Parsed parse_off_buffer(const char *data, size_t size, const std::string &name, Want want) {
-    ContentLines lines(data, size);
+    LineReader lines(data, data + size, name);
+    return parse_off_lines(lines, name, want);
+}
+
+Parsed parse_off_lines(LineReader &reader, const std::string &name, Want want) {
+    ContentLines lines(reader);
     std::string_view line, tok;
     bool normals = false;
     if (!lines.next(line) || !next_token(line, tok) || !off_keyword(tok, normals, name))
@@ -79,7 +84,7 @@ Parsed parse_off_buffer(const char *data, size_t size, const std::string &name, 
     Parsed out;
     const size_t columns = normals ? 6 : 3;
     // A vertex line takes at least 6 bytes ("0 0 0\n"): cap the reservation by that.
-    const size_t cap = std::min<uint64_t>(nv, (lines.remaining() + 1) / 6);
+    const size_t cap = static_cast<size_t>(std::min<uint64_t>(nv, (lines.remaining() + 1) / 6));
     out.positions.reserve(3 * cap);
     if (normals) out.normals.reserve(3 * cap);
     for (uint64_t i = 0; i < nv; ++i) {
@@ -99,7 +104,7 @@ Parsed parse_off_buffer(const char *data, size_t size, const std::string &name, 
     }
     if (want == Want::points) return out;
 
-    out.triangles.reserve(3 * std::min<uint64_t>(nf, (lines.remaining() + 1) / 8));
+    out.triangles.reserve(3 * static_cast<size_t>(std::min<uint64_t>(nf, (lines.remaining() + 1) / 8)));
     std::vector<uint32_t> polygon;
     for (uint64_t f = 0; f < nf; ++f) {
         if (!lines.next(line))

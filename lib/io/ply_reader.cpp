@@ -12,6 +12,7 @@
 #include <cstring>
 #include <string>
 #include <string_view>
+#include <unordered_set>
 #include <vector>
 
 #include "io/errors.hpp"
@@ -92,12 +93,17 @@ struct Header {
 };
 
 Header parse_header(const char *data, size_t size, const std::string &name) {
-    LineReader lines(data, data + size);
+    LineReader lines(data, data + size, name);
     std::string_view line, tok;
     if (!lines.next(line) || line != "ply")
         fail(GMPU_ERROR_PARSE, name, "not a PLY file (the first line is not 'ply')");
     Header h;
     bool have_format = false;
+    // Duplicate checks by hash, not by scanning what came before: a hostile header may list
+    // hundreds of thousands of elements or properties.
+    std::unordered_set<std::string> element_names;
+    std::unordered_set<std::string> property_keys;  // element index, '\0', property name
+    std::vector<std::string_view> args;             // of the current line
     while (lines.next(line)) {
         const size_t ln = lines.line_number();
         auto where = [&] { return "header line " + std::to_string(ln) + ": "; };
@@ -111,7 +117,7 @@ Header parse_header(const char *data, size_t size, const std::string &name) {
             return h;
         }
         const std::string_view keyword = tok;
-        std::vector<std::string_view> args;
+        args.clear();
         while (next_token(rest, tok)) args.push_back(tok);
         if (keyword == "format") {
             if (args.size() != 2) fail(GMPU_ERROR_PARSE, name, where() + "expected 'format <type> 1.0'");
@@ -131,9 +137,8 @@ Header parse_header(const char *data, size_t size, const std::string &name) {
             e.name = std::string(args[0]);
             e.count = static_cast<uint64_t>(count);
             e.header_line = ln;
-            for (const Element &other : h.elements)
-                if (other.name == e.name)
-                    fail(GMPU_ERROR_PARSE, name, where() + "duplicate element " + quoted(e.name));
+            if (!element_names.insert(e.name).second)
+                fail(GMPU_ERROR_PARSE, name, where() + "duplicate element " + quoted(e.name));
             h.elements.push_back(std::move(e));
         } else if (keyword == "property") {
             if (h.elements.empty()) fail(GMPU_ERROR_PARSE, name, where() + "property before any element");
@@ -154,7 +159,10 @@ Header parse_header(const char *data, size_t size, const std::string &name) {
                 p.name = std::string(args[1]);
             }
             Element &e = h.elements.back();
-            if (e.find(p.name) >= 0)
+            std::string key = std::to_string(h.elements.size() - 1);
+            key += '\0';
+            key += p.name;
+            if (!property_keys.insert(std::move(key)).second)
                 fail(GMPU_ERROR_PARSE, name, where() + "duplicate property " + quoted(p.name));
             e.props.push_back(std::move(p));
         } else {
@@ -433,6 +441,25 @@ Parsed Body::run() {
 }
 
 }  // namespace
+
+bool check_ply_header(const char *data, size_t size, const std::string &name) {
+    // The magic first: a file that is not a PLY fails on its first bytes.
+    LineReader lines(data, data + size, name);
+    std::string_view first;
+    const char *nl = static_cast<const char *>(std::memchr(data, '\n', size));
+    if ((nl || size >= 8) && (!lines.next(first) || first != "ply"))
+        fail(GMPU_ERROR_PARSE, name, "not a PLY file (the first line is not 'ply')");
+    // Then the whole header, once it is all there.
+    for (const char *p = data;
+         (p = static_cast<const char *>(std::memchr(p, '\n', size - static_cast<size_t>(p - data))));) {
+        ++p;
+        if (static_cast<size_t>(data + size - p) >= 10 && std::memcmp(p, "end_header", 10) == 0) {
+            parse_header(data, size, name);
+            return true;
+        }
+    }
+    return false;
+}
 
 Parsed parse_ply_buffer(const char *data, size_t size, const std::string &name, Want want) {
     Header h = parse_header(data, size, name);

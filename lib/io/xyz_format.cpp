@@ -13,8 +13,13 @@
 namespace gmpu::io::detail {
 
 Parsed parse_xyz_buffer(const char *data, size_t size, const std::string &name) {
+    LineReader lines(data, data + size, name);
+    return parse_xyz_lines(lines, name, 0);
+}
+
+Parsed parse_xyz_lines(LineReader &lines, const std::string &name, uint64_t line_count) {
     Parsed out;
-    LineReader lines(data, data + size);
+    out.positions.reserve(3 * line_count);
     std::string_view line, tok;
     size_t columns = 0, first_line = 0;
     while (lines.next(line)) {
@@ -36,6 +41,7 @@ Parsed parse_xyz_buffer(const char *data, size_t size, const std::string &name) 
                                                  " columns; expected 3 (x y z) or 6 (x y z nx ny nz)");
             columns = n;
             first_line = lines.line_number();
+            if (columns == 6) out.normals.reserve(3 * line_count);
         } else if (n != columns) {
             fail(GMPU_ERROR_PARSE, name, "line " + std::to_string(lines.line_number()) + ": " + std::to_string(n) +
                                              " columns, but line " + std::to_string(first_line) + " has " +

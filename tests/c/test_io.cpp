@@ -10,6 +10,8 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
+#include <utility>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -688,6 +690,146 @@ void test_write_large_buffered(void **) {
     assert_doubles_equal(c.normals, xyz);
 }
 
+
+// ---- inputs that are not ordinary files, hostile headers, BOMs, memory ----------------
+
+// GMPU_TEST_QUICK=1 (set by `make test-valgrind`): smaller inputs, no CPU-time bounds.
+bool quick() {
+    const char *q = std::getenv("GMPU_TEST_QUICK");
+    return q && *q && std::strcmp(q, "0") != 0;
+}
+
+double thread_cpu_seconds() {
+    timespec t;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
+
+// A FIFO would block the reader for ever, /dev/zero never ends: both fail at once, before
+// a byte is read, as does a directory.
+void test_input_must_be_a_regular_file(void **) {
+    const std::string fifo = path_of("pipe.xyz");
+    assert_int_equal(::mkfifo(fifo.c_str(), 0644), 0);
+    expect_read_error(fifo, GMPU_ERROR_IO, {"FIFO", "not a regular file"});
+    const std::string zero = path_of("zero.xyz");
+    assert_int_equal(::symlink("/dev/zero", zero.c_str()), 0);
+    expect_read_error(zero, GMPU_ERROR_IO, {"character device"});
+    expect_read_error(fresh_dir("dir.xyz"), GMPU_ERROR_IO, {"Is a directory"});
+}
+
+// A 2 GB file of zeros (sparse: no disk used) is not read whole: the PLY fails on its first
+// line, the text format on its first overlong line.
+void test_huge_files_fail_on_their_first_bytes(void **) {
+    for (const char *name : {"sparse.ply", "sparse.xyz", "sparse.obj", "sparse.off"}) {
+        const std::string p = path_of(name);
+        assert_int_equal(::truncate(put(name, "").c_str(), off_t{2} << 30), 0);
+        const double t0 = thread_cpu_seconds();
+        expect_read_error(p, GMPU_ERROR_PARSE, {std::string(name).find("ply") != std::string::npos ? "not a PLY file"
+                                                                                                  : "longer than"});
+        const double cpu = thread_cpu_seconds() - t0;
+        if (cpu > 1.0 && !quick()) fail_msg("%s: %.2f s of CPU: the file was read whole", name, cpu);
+        ::unlink(p.c_str());
+    }
+}
+
+// 200,000 empty elements before the vertex: the duplicate-name checks are hashed, so the
+// header is linear in its length (a pairwise check is quadratic: minutes of CPU).
+void test_ply_header_with_many_elements_is_linear(void **) {
+    std::string h = "ply\nformat ascii 1.0\n";
+    const int elements = quick() ? 20000 : 200000;
+    for (int i = 0; i < elements; ++i) h += "element e" + std::to_string(i) + " 0\n";
+    h += "element vertex 2\nproperty float x\nproperty float y\nproperty float z\nend_header\n1 2 3\n4 5 6\n";
+    const std::string p = put("many_elements.ply", h);
+    const double t0 = thread_cpu_seconds();
+    assert_doubles_equal(gmpu::io::read_points(p).positions, {1, 2, 3, 4, 5, 6});
+    // The same with a duplicate at the very end: found, and as fast.
+    std::string dup = h;
+    dup.replace(dup.find("element vertex"), 0, "element e7 0\n");
+    expect_read_error(put("dup_element.ply", dup), GMPU_ERROR_PARSE, {"duplicate element 'e7'"});
+    const double cpu = thread_cpu_seconds() - t0;
+    if (cpu > 5.0 && !quick()) fail_msg("200k-element header: %.2f s of CPU (quadratic?)", cpu);
+}
+
+// A UTF-8 byte order mark (what Windows editors write first) does not eat the first vertex.
+void test_utf8_bom_is_skipped(void **) {
+    const std::string bom = "\xEF\xBB\xBF";
+    assert_doubles_equal(gmpu::io::read_points(put("bom.obj", bom + "v 1 2 3\nv 4 5 6\n")).positions, {1, 2, 3, 4, 5, 6});
+    assert_doubles_equal(gmpu::io::read_points(put("bom.xyz", bom + "1 2 3\n4 5 6\n")).positions, {1, 2, 3, 4, 5, 6});
+    assert_doubles_equal(gmpu::io::read_points(put("bom.off", bom + "OFF\n2 0 0\n1 2 3\n4 5 6\n")).positions,
+                         {1, 2, 3, 4, 5, 6});
+    assert_doubles_equal(gmpu::io::read_points(put("bom.ply", bom + "ply\nformat ascii 1.0\nelement vertex 1\n"
+                                                                    "property float x\nproperty float y\n"
+                                                                    "property float z\nend_header\n1 2 3\n"))
+                             .positions,
+                         {1, 2, 3});
+    // In the buffer parsers too (the fuzzers' entry points).
+    const std::string obj = bom + "v 7 8 9\n";
+    assert_doubles_equal(gmpu::io::detail::parse_obj_buffer(obj.data(), obj.size(), "mem", gmpu::io::detail::Want::points)
+                             .positions,
+                         {7, 8, 9});
+}
+
+// Text formats are read into arrays sized once from a count of the lines: no growth by
+// doubling (which holds up to 3x the points while copying). Lines split across the
+// reader's 1 MiB chunks and a last line without its newline parse like any other.
+void test_text_arrays_sized_once(void **) {
+    const size_t n = 100001;
+    std::string xyz, obj = "# mesh\n";
+    for (size_t i = 0; i < n; ++i) {
+        const std::string line = std::to_string(i) + " " + std::to_string(i % 7) + ".25 -" + std::to_string(i % 13);
+        xyz += line + (i + 1 < n ? "\n" : "");
+        obj += "v " + line + "\n";
+    }
+    for (const auto &[name, text] : {std::pair<const char *, std::string>{"many.xyz", xyz}, {"many.obj", obj}}) {
+        PointCloud c = gmpu::io::read_points(put(name, text));
+        assert_int_equal(c.size(), n);
+        assert_true(c.positions.capacity() <= c.positions.size() + 3 * 2);
+        assert_true(c.positions[3 * (n - 1)] == double(n - 1));
+        assert_true(c.positions[3 * 77777 + 2] == -double(77777 % 13));
+    }
+}
+
+// A symlink as the output is written through: its target gets the bytes, the link stays
+// (relative links resolve from the link's directory; a chain is followed to its end).
+void test_write_through_symlinks(void **) {
+    const std::string dir = fresh_dir("links");
+    const double v[] = {1, 2, 3};
+    assert_int_equal(::mkdir((dir + "/real").c_str(), 0755), 0);
+    std::ofstream(dir + "/real/cloud.xyz") << "old\n";
+    assert_int_equal(::symlink("real/cloud.xyz", (dir + "/link1.xyz").c_str()), 0);
+    assert_int_equal(::symlink("link1.xyz", (dir + "/link2.xyz").c_str()), 0);
+    gmpu::io::write_points(dir + "/link2.xyz", v, nullptr, 1);
+    assert_string_equal(slurp(dir + "/real/cloud.xyz").c_str(), "1 2 3\n");
+    struct stat st;
+    for (const char *link : {"/link1.xyz", "/link2.xyz"}) {
+        assert_int_equal(::lstat((dir + link).c_str(), &st), 0);
+        assert_true(S_ISLNK(st.st_mode));
+    }
+    assert_int_equal(entries(dir + "/real").size(), 1);
+    assert_int_equal(::symlink("loop.xyz", (dir + "/loop.xyz").c_str()), 0);
+    expect_error([&] { gmpu::io::write_points(dir + "/loop.xyz", v, nullptr, 1); }, GMPU_ERROR_IO,
+                 {"loop.xyz", "symbolic links"});
+    assert_int_equal(entries(dir).size(), 4);  // real, link1, link2, loop: nothing else
+}
+
+// A leftover temporary of a killed run with our pid (or any run of them) does not stop a
+// write; a 251-character name (legal) gets a temporary that fits NAME_MAX.
+void test_write_temporaries_fit_and_skip_leftovers(void **) {
+    const std::string dir = fresh_dir("temps");
+    const double v[] = {1, 2, 3};
+    const std::string p = dir + "/out.xyz";
+    for (int n = 0; n < 300; ++n)
+        std::ofstream(p + ".tmp-gmpu-" + std::to_string(::getpid()) + "-" + std::to_string(n)) << "stale";
+    gmpu::io::write_points(p, v, nullptr, 1);
+    assert_string_equal(slurp(p).c_str(), "1 2 3\n");
+    assert_int_equal(entries(dir).size(), 301);  // the leftovers are not ours to remove
+    const std::string long_dir = fresh_dir("long");
+    const std::string long_name = long_dir + "/" + std::string(247, 'n') + ".xyz";
+    gmpu::io::write_points(long_name, v, nullptr, 1);
+    assert_string_equal(slurp(long_name).c_str(), "1 2 3\n");
+    assert_int_equal(entries(long_dir).size(), 1);
+}
+
 // ---- the in-memory parsers (what the fuzzers call) ------------------------------------
 
 void test_buffer_parsers(void **) {
@@ -778,6 +920,13 @@ int main(void) {
         cmocka_unit_test(test_write_failures_leave_nothing),
         cmocka_unit_test(test_write_replaces_atomically),
         cmocka_unit_test(test_write_large_buffered),
+        cmocka_unit_test(test_input_must_be_a_regular_file),
+        cmocka_unit_test(test_huge_files_fail_on_their_first_bytes),
+        cmocka_unit_test(test_ply_header_with_many_elements_is_linear),
+        cmocka_unit_test(test_utf8_bom_is_skipped),
+        cmocka_unit_test(test_text_arrays_sized_once),
+        cmocka_unit_test(test_write_temporaries_fit_and_skip_leftovers),
+        cmocka_unit_test(test_write_through_symlinks),
         cmocka_unit_test(test_buffer_parsers),
         cmocka_unit_test(test_shared_clouds),
         cmocka_unit_test(test_shared_mesh_and_scan),

@@ -12,6 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "gmpu/gmpu.h"
 #include "scratch_dir.h"
@@ -139,6 +140,27 @@ static void test_points_read_errors(void **state) {
     put(ply, "ply\nformat binary_middle_endian 1.0\nend_header\n");
     check_failure(gmpu_points_read(ply, &p), GMPU_ERROR_UNSUPPORTED, "binary_middle_endian");
     assert_null(p);
+    /* Not regular files: a FIFO (would block for ever), a device (never ends), a directory. */
+    const char *fifo = scratch_path("fifo.ply");
+    assert_int_equal(mkfifo(fifo, 0644), 0);
+    check_failure(gmpu_points_read(fifo, &p), GMPU_ERROR_IO, "FIFO");
+    remove(fifo);
+    const char *zero = scratch_path("zero.xyz");
+    assert_int_equal(symlink("/dev/zero", zero), 0);
+    check_failure(gmpu_points_read(zero, &p), GMPU_ERROR_IO, "not a regular file");
+    remove(zero);
+    const char *dir = scratch_path("dir.obj");
+    assert_int_equal(mkdir(dir, 0755), 0);
+    check_failure(gmpu_points_read(dir, &p), GMPU_ERROR_IO, "Is a directory");
+    rmdir(dir);
+    /* A UTF-8 byte order mark does not cost the first vertex. */
+    const char *obj = scratch_path("bom.obj");
+    put(obj, "\xEF\xBB\xBFv 1 2 3\nv 4 5 6\nv 7 8 9\n");
+    assert_int_equal(gmpu_points_read(obj, &p), GMPU_OK);
+    assert_int_equal(gmpu_points_count(p), 3);
+    assert_true(gmpu_points_positions(p)[0] == 1.0);
+    gmpu_points_destroy(p);
+    remove(obj);
 }
 
 static void test_points_write_errors(void **state) {

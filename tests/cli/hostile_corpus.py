@@ -10,7 +10,8 @@ reader takes (PLY ascii / binary little / big endian, XYZ, OFF, OBJ), then broke
 a file met in the wild can be: truncated anywhere, headers that lie about counts or
 formats, list properties in the vertex element, NaN / inf / huge / tiny / subnormal values,
 garbage numbers, random bytes, bit flips, wrong extensions, 0-3 points, identical,
-collinear and coplanar points, a directory, a dangling symlink, a missing file.
+collinear and coplanar points, UTF-8 byte order marks, a 200k-element header, 2 GB sparse
+files, a FIFO, /dev/zero, a directory, a dangling symlink, a missing file.
 
 Each file has an expectation in the manifest:
   error  -> exit 1, exactly one line on stderr ("gmpu-reconstruct: ..."), no output file
@@ -301,6 +302,36 @@ def generate(out_dir, seed):
     add("off_named.obj", off_bytes(sph), "error")
     add("unknown.stl", b"solid x\nendsolid x\n", "error")
     add("noext", xyz_bytes(sph), "error")
+
+    # A UTF-8 byte order mark before the first line: read like the file without it.
+    bom = b"\xef\xbb\xbf"
+    add("bom_sphere.obj", bom + obj_bytes(sph), "ok", sph_shape)
+    add("bom_sphere.xyz", bom + xyz_bytes(sph), "ok", sph_shape)
+    add("bom_sphere.off", bom + off_bytes(sph), "ok", sph_shape)
+    add("bom_sphere_ascii.ply", bom + ply_bytes(sph), "ok", sph_shape)
+    # 200,000 empty elements before the vertex element: linear header checks, so quick.
+    add("many_empty_elements.ply", ply_bytes(sph, "binary_little_endian", extra_header="".join(
+        "element e%d 0\n" % i for i in range(200000))), "ok", sph_shape)
+    add("many_elements_duplicate.ply", ply_bytes(sph, extra_header="".join(
+        "element e%d 0\n" % i for i in range(200000)) + "element e5 0\n"), "error")
+    # 2 GB of zeros (sparse: no disk space) in every format: fails on the first bytes.
+    for ext in ("ply", "xyz", "obj", "off"):
+        p = os.path.join(in_dir, "sparse_2gb." + ext)
+        with open(p, "wb") as f:
+            f.truncate(2 << 30)
+        manifest["sparse_2gb." + ext] = {"expect": "error", "shape": None}
+    # Not regular files: a FIFO (would block the reader), a device that never ends.
+    p = os.path.join(in_dir, "fifo.ply")
+    if os.path.lexists(p):
+        os.remove(p)
+    os.mkfifo(p)
+    manifest["fifo.ply"] = {"expect": "error", "shape": None}
+    for name in ("dev_zero.xyz", "dev_zero.ply"):
+        p = os.path.join(in_dir, name)
+        if os.path.lexists(p):
+            os.remove(p)
+        os.symlink("/dev/zero", p)
+        manifest[name] = {"expect": "error", "shape": None}
 
     # Not files: a directory, a dangling symlink, a symlink loop; and a missing path.
     os.makedirs(os.path.join(in_dir, "directory.ply"), exist_ok=True)

@@ -13,7 +13,9 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <dirent.h>
 #include <fcntl.h>
+#include <signal.h>
 #include <limits.h>
 #include <math.h>
 #include <spawn.h>
@@ -478,6 +480,279 @@ static void test_bad_usage(void **state) {
     check_run(&r, 0, NULL);
 }
 
+
+/* ---- outputs: never lose a file, checked before any work ---- */
+
+static char *slurp_file(const char *path, size_t *size) {
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *data = malloc((size_t)n + 1);
+    *size = fread(data, 1, (size_t)n, f);
+    data[*size] = '\0';
+    fclose(f);
+    return data;
+}
+
+static void assert_file_is(const char *path, const char *text) {
+    size_t n = 0;
+    char *data = slurp_file(path, &n);
+    if (!data) fail_msg("%s is gone", path);
+    if (n != strlen(text) || memcmp(data, text, n) != 0) fail_msg("%s changed: '%.60s'", path, data);
+    free(data);
+}
+
+/* Whether a staging file ("<name>.gmpu-<pid>-<k>.<ext>") or a library temporary
+ * ("<name>.tmp-gmpu-<pid>-<n>") is in dir: what an interrupted or failed run leaves behind. */
+static int staging_in(const char *dir) {
+    DIR *d = opendir(dir);
+    struct dirent *e;
+    int found = 0;
+    while (d && (e = readdir(d)) != NULL) found |= strstr(e->d_name, ".gmpu-") || strstr(e->d_name, "tmp-gmpu");
+    if (d) closedir(d);
+    return found;
+}
+
+static void assert_no_staging_left(void) { assert_false(staging_in(scratch_dir)); }
+
+/* The input named as the output, with a --normals-out that cannot be written: the cloud
+ * survives (the mesh once replaced it and the failed points write removed it). */
+static void test_input_never_lost(void **state) {
+    (void)state;
+    const char *cloud = scratch_path("keep-cloud.xyz");
+    put_xyz(cloud, g_sphere, N_SPHERE);
+    size_t n0 = 0;
+    char *before = slurp_file(cloud, &n0);
+    const char *a1[] = {cloud, "-o", cloud, "--normals-out", scratch_path("no/dir/n.ply"), "--quiet", NULL};
+    run_result r = run_cli(a1);
+    check_run(&r, 1, NULL);
+    /* Same with the mesh extension the CLI writes, through another name for the same file. */
+    const char *cloud_ply = scratch_path("keep-cloud.ply");
+    put_ply_le(cloud_ply, g_sphere, N_SPHERE, 0);
+    size_t p0 = 0;
+    char *ply_before = slurp_file(cloud_ply, &p0);
+    const char *alias = scratch_path("alias.ply");
+    assert_int_equal(symlink(cloud_ply, alias), 0);
+    const char *a2[] = {cloud_ply, "-o", alias, "--quiet", "--resolution", "24", NULL};
+    r = run_cli(a2);
+    check_run(&r, 1, "is the input file");
+    const char *a3[] = {cloud_ply, "-o", cloud_ply, "--normals-out", scratch_path("no/dir/n.ply"), "--quiet", NULL};
+    r = run_cli(a3);
+    check_run(&r, 1, NULL);
+    size_t n1 = 0, p1 = 0;
+    char *after = slurp_file(cloud, &n1), *ply_after = slurp_file(cloud_ply, &p1);
+    assert_non_null(after);
+    assert_non_null(ply_after);
+    assert_true(n0 == n1 && memcmp(before, after, n0) == 0);
+    assert_true(p0 == p1 && memcmp(ply_before, ply_after, p0) == 0);
+    free(before), free(after), free(ply_before), free(ply_after);
+    remove(alias);
+    assert_no_staging_left();
+}
+
+/* An older good output survives a run whose oriented points cannot be written; -o X
+ * --normals-out X is refused (the points used to replace the mesh silently). */
+static void test_older_output_and_same_file(void **state) {
+    (void)state;
+    const char *in = scratch_path("keep-sphere.xyz");
+    put_xyz(in, g_sphere, N_SPHERE);
+    const char *out = scratch_path("keep-out.ply");
+    put_text(out, "previous result");
+    const char *a1[] = {in, "-o", out, "--normals-out", scratch_path("no/dir/n.ply"), "--resolution", "24", NULL};
+    run_result r = run_cli(a1);
+    check_run(&r, 1, "no/dir/n.ply");
+    assert_null(strstr(r.err, "gmpu: fit")); /* refused before any work: no progress */
+    assert_file_is(out, "previous result");
+    /* A points write that fails after the work (as root, /proc passes the access check but
+     * takes no new file): the mesh, though written, does not replace the older output. */
+    const char *a1b[] = {in, "-o", out, "--normals-out", "/proc/gmpu-points.xyz", "--quiet", "--resolution", "24", NULL};
+    r = run_cli(a1b);
+    check_run(&r, 1, "/proc/gmpu-points.xyz");
+    assert_file_is(out, "previous result");
+    const char *a2[] = {in, "-o", out, "--normals-out", scratch_path("points.xyz"), "--normals-out", out,
+                        "--quiet", NULL};
+    r = run_cli(a2);
+    check_run(&r, 1, "are the same file");
+    assert_file_is(out, "previous result");
+    const char *fresh = scratch_path("fresh.ply");
+    const char *a3[] = {in, "-o", fresh, "--normals-out", fresh, "--quiet", NULL};
+    r = run_cli(a3);
+    check_run(&r, 1, "are the same file");
+    assert_false(exists(fresh));
+    /* Output checks happen before the input is even read: a bad directory, a directory as
+     * the output, an unknown extension all fail with one line and no progress. */
+    const char *bad[] = {scratch_path("no/such/dir/m.ply"), scratch_dir, scratch_path("m.stl"),
+                         scratch_path("keep-sphere.xyz")};
+    for (size_t k = 0; k < sizeof bad / sizeof *bad; ++k) {
+        const char *a4[] = {in, "-o", bad[k], "--resolution", "24", NULL};
+        r = run_cli(a4);
+        check_run(&r, 1, NULL);
+        assert_null(strstr(r.err, "gmpu: fit"));
+    }
+    assert_no_staging_left();
+}
+
+/* getopt_long: --opt=value works; a flag is never taken as a file name. */
+static void test_option_syntax(void **state) {
+    (void)state;
+    const char *in = scratch_path("keep-sphere.xyz");
+    put_xyz(in, g_sphere, N_SPHERE);
+    const char *a1[] = {in, "-o", "--threads", "2", "--quiet", NULL};
+    run_result r = run_cli(a1);
+    check_run(&r, 2, "-o needs a file name, got '--threads'");
+    assert_false(exists("--threads"));
+    const char *a2[] = {in, "-o", scratch_path("m.off"), "--normals-out", "--quiet", NULL};
+    r = run_cli(a2);
+    check_run(&r, 2, "--normals-out needs a file name");
+    const char *out = scratch_path("eq.off");
+    char output_eq[PATH_MAX + 16];
+    snprintf(output_eq, sizeof output_eq, "--output=%s", out);
+    const char *a3[] = {"--resolution=24", output_eq, "--threads=2", "--quiet", in, NULL};
+    r = run_cli(a3);
+    check_run(&r, 0, NULL);
+    const double c[3] = {0, 0, 0};
+    check_off_sphere(out, c, 1.0, 0.05);
+    remove(out);
+    const char *a4[] = {in, "-o", out, "--resolution=abc", NULL};
+    r = run_cli(a4);
+    check_run(&r, 2, "--resolution needs a number, got 'abc'");
+    const char *version[] = {"--version", NULL};
+    r = run_cli(version);
+    check_run(&r, 0, NULL);
+    assert_no_staging_left();
+}
+
+/* A symlinked output is written through: the link stays, its target gets the mesh. A
+ * 251-character output name works (its temporaries fit in NAME_MAX). */
+static void test_symlink_and_long_names(void **state) {
+    (void)state;
+    const char *in = scratch_path("keep-sphere.xyz");
+    put_xyz(in, g_sphere, N_SPHERE);
+    const char *dir = scratch_path("keep-real");
+    mkdir(dir, 0755);
+    const char *target = scratch_path("keep-real/mesh.off");
+    put_text(target, "old");
+    const char *link = scratch_path("keep-link.off");
+    assert_int_equal(symlink("keep-real/mesh.off", link), 0);
+    const char *a1[] = {in, "-o", link, "--quiet", "--resolution", "24", NULL};
+    run_result r = run_cli(a1);
+    check_run(&r, 0, NULL);
+    struct stat st;
+    assert_int_equal(lstat(link, &st), 0);
+    assert_true(S_ISLNK(st.st_mode));
+    const double c[3] = {0, 0, 0};
+    check_off_sphere(target, c, 1.0, 0.05);
+    assert_int_equal(scratch_count(dir, ""), 1);
+    assert_false(staging_in(dir));
+    /* The format follows the name written on the command line, not the link target's. */
+    const char *data = scratch_path("keep-real/mesh.data");
+    put_text(data, "old");
+    const char *link2 = scratch_path("keep-link2.off");
+    assert_int_equal(symlink("keep-real/mesh.data", link2), 0);
+    const char *a1b[] = {in, "-o", link2, "--quiet", "--resolution", "24", NULL};
+    r = run_cli(a1b);
+    check_run(&r, 0, NULL);
+    check_off_sphere(data, c, 1.0, 0.05);
+    assert_int_equal(scratch_count(dir, ""), 2);
+
+    char name[260];
+    memset(name, 'n', 247);
+    strcpy(name + 247, ".off");
+    assert_int_equal(strlen(name), 251);
+    const char *long_out = scratch_path(name);
+    const char *a2[] = {in, "-o", long_out, "--quiet", "--resolution", "24", "--normals-out", scratch_path("keep-p.xyz"),
+                        NULL};
+    r = run_cli(a2);
+    check_run(&r, 0, NULL);
+    check_off_sphere(long_out, c, 1.0, 0.05);
+    remove(long_out);
+    remove(scratch_path("keep-p.xyz"));
+    assert_no_staging_left();
+}
+
+/* Runs a reconstruction and sends `sig` the moment a staging file appears; 1 if the signal
+ * killed it mid-write, 0 if the run finished writing first (then the caller retries). */
+static int kill_during_write(const char *in, const char *out, int sig) {
+    const char *argv[] = {g_cli, in, "-o", out, "--quiet", "--resolution", "100", NULL};
+    posix_spawn_file_actions_t fa;
+    posix_spawn_file_actions_init(&fa);
+    posix_spawn_file_actions_addopen(&fa, 1, "/dev/null", O_WRONLY, 0);
+    posix_spawn_file_actions_addopen(&fa, 2, "/dev/null", O_WRONLY, 0);
+    pid_t pid;
+    assert_int_equal(posix_spawn(&pid, g_cli, &fa, NULL, (char *const *)argv, environ), 0);
+    posix_spawn_file_actions_destroy(&fa);
+    int ws = 0, done = 0;
+    while (!done) {
+        if (staging_in(scratch_dir)) {
+            kill(pid, sig);
+            break;
+        }
+        done = waitpid(pid, &ws, WNOHANG) == pid;
+        usleep(200);
+    }
+    if (!done) waitpid(pid, &ws, 0);
+    if (!WIFSIGNALED(ws)) {
+        assert_int_equal(WEXITSTATUS(ws), 0);
+        return 0;
+    }
+    assert_int_equal(WTERMSIG(ws), sig);
+    return 1;
+}
+
+/* SIGTERM or SIGINT while the mesh is being written: the process dies of it and leaves
+ * neither the output nor a staging file or temporary beside it. */
+static void test_sigterm_during_write_leaves_nothing(void **state) {
+    (void)state;
+    const char *in = scratch_path("keep-sphere.xyz");
+    put_xyz(in, g_sphere, N_SPHERE);
+    const char *out = scratch_path("big.obj");
+    const int signals[] = {SIGTERM, SIGINT};
+    for (int k = 0; k < 2; ++k) {
+        int caught = 0;
+        for (int attempt = 0; attempt < 4 && !caught; ++attempt) {
+            remove(out);
+            caught = kill_during_write(in, out, signals[k]);
+            if (caught) assert_false(exists(out));
+            assert_false(staging_in(scratch_dir));
+            remove(out);
+        }
+        if (!caught) fail_msg("the write never outlasted the polling: signal %d was not tested", signals[k]);
+    }
+}
+
+/* SIGKILL cannot be caught: its staging files stay. The next run ignores them (fresh names,
+ * never theirs) and leaves them alone: they are not its files. */
+static void test_leftovers_of_a_killed_run_are_ignored(void **state) {
+    (void)state;
+    const char *in = scratch_path("keep-sphere.xyz");
+    put_xyz(in, g_sphere, N_SPHERE);
+    const char *out = scratch_path("killed.obj");
+    int caught = 0;
+    for (int attempt = 0; attempt < 4 && !caught; ++attempt) {
+        remove(out);
+        caught = kill_during_write(in, out, SIGKILL);
+    }
+    if (!caught) fail_msg("the write never outlasted the polling: SIGKILL was not tested");
+    assert_true(staging_in(scratch_dir));
+    const int left = scratch_count(scratch_dir, "killed.obj.");
+    assert_true(left >= 1);
+    const char *args[] = {in, "-o", out, "--normals-out", scratch_path("killed.obj.xyz"), "--quiet", "--resolution",
+                          "24", NULL};
+    run_result r = run_cli(args);
+    check_run(&r, 0, NULL);
+    assert_true(exists(out));
+    assert_int_equal(scratch_count(scratch_dir, "killed.obj."), left + 1); /* + the points file */
+    /* Clean up what the killed run left. */
+    DIR *d = opendir(scratch_dir);
+    struct dirent *e;
+    while (d && (e = readdir(d)) != NULL)
+        if (strncmp(e->d_name, "killed.", 7) == 0) remove(scratch_path(e->d_name));
+    if (d) closedir(d);
+    assert_no_staging_left();
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_missinscratch_directory_and_unknown_inputs),
@@ -488,6 +763,12 @@ int main(void) {
         cmocka_unit_test(test_extreme_scales),
         cmocka_unit_test(test_outputs),
         cmocka_unit_test(test_bad_usage),
+        cmocka_unit_test(test_input_never_lost),
+        cmocka_unit_test(test_older_output_and_same_file),
+        cmocka_unit_test(test_option_syntax),
+        cmocka_unit_test(test_symlink_and_long_names),
+        cmocka_unit_test(test_sigterm_during_write_leaves_nothing),
+        cmocka_unit_test(test_leftovers_of_a_killed_run_are_ignored),
     };
     return cmocka_run_group_tests(tests, group_setup, group_teardown);
 }
