@@ -13,6 +13,7 @@ namespace gmpu {
 namespace {
 
 constexpr size_t kCentres = 1024;
+constexpr size_t kMinCentres = 256;
 // The two neighbourhood sizes compared (nearest in the tangent plane). Twice the points is
 // twice the area, so a residual that comes from the shape grows at least √2-fold (a crease:
 // linearly in the radius; smooth curvature: with its cube) while noise stays the same.
@@ -29,21 +30,30 @@ constexpr double kBallPerNoise = 5.0;  // ball radius wanted, in estimated σ
 // apart are two sheets (a thin wall), not noise: a Gaussian sample of 24 splits by less.
 constexpr double kSheetSeparation = 6.0;
 constexpr size_t kSheetMinSide = 4;
+// The residuals are read at this quantile over the centres (z its standard normal score):
+// noise is everywhere, while the residual of a shape too sparsely sampled for its detail
+// (gear teeth, creases) is where that detail is, so a low quantile reads the noise alone.
+constexpr double kQuantile = 0.1;
+constexpr double kQuantileZ = -1.2816;
 
 struct Local {
     double u, v, w;  // tangential coordinates and height in the ball's PCA frame
     double t2;       // squared tangential distance
 };
 
-double median(std::vector<double> &v) {
+double quantile(std::vector<double> &v, double q) {
     if (v.empty()) return 0.0;
-    std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
-    return v[v.size() / 2];
+    const size_t i = size_t(q * double(v.size() - 1));
+    std::nth_element(v.begin(), v.begin() + long(i), v.end());
+    return v[i];
 }
 
-// Median of √(χ²_ν / ν) (Wilson–Hilferty): what the median of unbiased RMS residuals with
-// ν degrees of freedom reads for unit noise.
-double chi_median(double dof) { return std::pow(1.0 - 2.0 / (9.0 * dof), 1.5); }
+// The kQuantile-quantile of √(χ²_ν / ν) (Wilson–Hilferty): what that quantile of unbiased
+// RMS residuals with ν degrees of freedom reads for unit noise.
+double chi_quantile(double dof) {
+    const double a = 2.0 / (9.0 * dof);
+    return std::pow(std::max(0.0, 1.0 - a + kQuantileZ * std::sqrt(a)), 1.5);
+}
 
 // Least-squares height w = a u² + b uv + c v² + d u + e v + f (or only its affine part when
 // `terms` is 3) over fit; returns the residuals of all of pts. `scale` balances the normal
@@ -134,9 +144,9 @@ struct Scales {
     double ball = 0.0;             // median ball radius
 };
 
-Scales measure(const PointSet &points, size_t ball) {
+Scales measure(const PointSet &points, size_t ball, size_t centres) {
     const size_t n = points.size();
-    const size_t step = std::max<size_t>(1, n / kCentres);
+    const size_t step = std::max<size_t>(1, n / centres);
     std::vector<double> near, far, radii, residuals;
     std::vector<uint32_t> idx;
     std::vector<float> d2;
@@ -168,9 +178,9 @@ Scales measure(const PointSet &points, size_t ball) {
         radii.push_back(r);
     }
     Scales s;
-    s.near = median(near) / chi_median(double(kNear - 6));
-    s.far = median(far) / chi_median(double(kFar - 6));
-    s.ball = median(radii);
+    s.near = quantile(near, kQuantile) / chi_quantile(double(kNear - 6));
+    s.far = quantile(far, kQuantile) / chi_quantile(double(kFar - 6));
+    s.ball = quantile(radii, 0.5);
     return s;
 }
 
@@ -184,14 +194,18 @@ double noise_of(const Scales &s) { return std::sqrt(std::max(0.0, 2.0 * s.near *
 double estimate_noise(const PointSet &points) {
     size_t ball = std::min(kBall, points.size());
     if (ball < kFar) return 0.0;
-    Scales s = measure(points, ball);
+    Scales s = measure(points, ball, kCentres);
     double noise = noise_of(s);
     // Heavy noise: a ball only a few σ high cuts the noise's tails; measure again in a ball
     // tall enough (radius ∝ √points on a surface).
     if (s.ball > 0.0 && noise * kBallPerNoise > s.ball) {
         double want = std::pow(noise * kBallPerNoise / s.ball, 2.0) * double(ball);
         size_t wider = std::min({kMaxBall, points.size(), size_t(want)});
-        if (wider > ball) noise = std::max(noise, noise_of(measure(points, wider)));
+        // Fewer centres keep the cost of the taller balls bounded.
+        if (wider > ball) {
+            const size_t centres = std::max(kMinCentres, kCentres * ball / wider);
+            noise = std::max(noise, noise_of(measure(points, wider, centres)));
+        }
     }
     return noise;
 }
