@@ -138,7 +138,7 @@ typedef enum gmpu_param {
     GMPU_PARAM_MAX_TRIANGLES = 10,
     /* Noise floor for ε: fit estimates the sampling noise σ̂ and works to
      * max(GMPU_PARAM_ERROR, NOISE_SCALE × σ̂), since fitting below the noise only fits the
-     * noise. Default 2; 0 turns the floor off. Range [0, 20]. Discards a previous fit. */
+     * noise. Default 1.75; 0 turns the floor off. Range [0, 20]. Discards a previous fit. */
     GMPU_PARAM_NOISE_SCALE = 11
 } gmpu_param;
 
