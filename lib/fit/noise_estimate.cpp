@@ -23,12 +23,12 @@ constexpr size_t kFar = 24;
 // 3D distance from a noisy centre are biased towards points close to it in height (the
 // residual then under-reads the noise); chosen by tangential distance from a ball several σ
 // high, they are not.
-constexpr size_t kBall = 48;
+constexpr size_t kBall = 36;
 constexpr size_t kMaxBall = 1024;
 constexpr double kBallPerNoise = 5.0;  // ball radius wanted, in estimated σ
 // A neighbourhood's residuals split into two groups this many (pooled) standard deviations
 // apart are two sheets (a thin wall), not noise: a Gaussian sample of 24 splits by less.
-constexpr double kSheetSeparation = 6.0;
+constexpr double kSheetSeparation = 5.5;
 constexpr size_t kSheetMinSide = 4;
 // The residuals are read at this quantile over the centres (z its standard normal score):
 // noise is everywhere, while the residual of a shape too sparsely sampled for its detail
