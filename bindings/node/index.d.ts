@@ -82,7 +82,7 @@ export interface Parameters {
     maxCells?: number;
     /** Cap on polygonize triangles. Default 1e8. */
     maxTriangles?: number;
-    /** Noise floor for ε, in units of the estimated noise; 0 = off. Default 2, [0, 20]. */
+    /** Noise floor for ε, in units of the estimated noise; 0 = off. Default 1.75, [0, 20]. */
     noiseScale?: number;
 }
 export type ParameterName = keyof Parameters;

@@ -143,7 +143,7 @@ typedef enum gmpu_param {
     GMPU_PARAM_MAX_TRIANGLES = 10,
     /* Noise floor for ε: fit estimates the sampling noise σ̂ and works to
      * max(GMPU_PARAM_ERROR, NOISE_SCALE × σ̂), since fitting below the noise only fits the
-     * noise; 0 turns the floor off. Discards a previous fit. Default 2, range [0, 20]. */
+     * noise; 0 turns the floor off. Discards a previous fit. Default 1.75, range [0, 20]. */
     GMPU_PARAM_NOISE_SCALE = 11
 } gmpu_param;
 

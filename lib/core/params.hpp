@@ -5,7 +5,7 @@ namespace gmpu {
 
 struct Params {
     double error = 0.002;          // ε, fraction of the bounding-box diagonal
-    double noise_scale = 2.0;      // ε is at least this many estimated noise deviations
+    double noise_scale = 1.75;     // ε is at least this many estimated noise deviations
     int max_depth = 10;            // deepest octree level
     int min_points = 15;           // N_min: fewest points in a support ball
     double support_scale = 0.75;   // α: R = α × cell diagonal

@@ -4,62 +4,209 @@
 #include <cmath>
 #include <vector>
 
+#include <Eigen/Cholesky>
+
 #include "fit/fits.hpp"
 
 namespace gmpu {
 
 namespace {
-constexpr size_t kSamples = 1024;
-constexpr size_t kNeighbours = 24;
-// When the noise is this large a share of the neighbourhood's radius, a 24-point quadratic
-// absorbs much of it (sphere_scan: 0.63 % measured for about 1 % true); measure again on
-// neighbourhoods four times larger, where it cannot.
-constexpr double kHeavyNoise = 0.2;
-constexpr size_t kWideNeighbours = 96;
 
-double median(std::vector<double> &v) {
+constexpr size_t kCentres = 1024;
+constexpr size_t kMinCentres = 256;
+// The two neighbourhood sizes compared (nearest in the tangent plane). Twice the points is
+// twice the area, so a residual that comes from the shape grows at least √2-fold (a crease:
+// linearly in the radius; smooth curvature: with its cube) while noise stays the same.
+constexpr size_t kNear = 12;
+constexpr size_t kFar = 24;
+// The ball the frame and the tangent-plane neighbours are taken from. Neighbours chosen by
+// 3D distance from a noisy centre are biased towards points close to it in height (the
+// residual then under-reads the noise); chosen by tangential distance from a ball several σ
+// high, they are not.
+constexpr size_t kBall = 36;
+constexpr size_t kMaxBall = 1024;
+constexpr double kBallPerNoise = 5.0;  // ball radius wanted, in estimated σ
+// A neighbourhood's residuals split into two groups this many (pooled) standard deviations
+// apart are two sheets (a thin wall), not noise: a Gaussian sample of 24 splits by less.
+constexpr double kSheetSeparation = 5.5;
+constexpr size_t kSheetMinSide = 4;
+// The residuals are read at this quantile over the centres (z its standard normal score):
+// noise is everywhere, while the residual of a shape too sparsely sampled for its detail
+// (gear teeth, creases) is where that detail is, so a low quantile reads the noise alone.
+constexpr double kQuantile = 0.1;
+constexpr double kQuantileZ = -1.2816;
+
+struct Local {
+    double u, v, w;  // tangential coordinates and height in the ball's PCA frame
+    double t2;       // squared tangential distance
+};
+
+double quantile(std::vector<double> &v, double q) {
     if (v.empty()) return 0.0;
-    std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
-    return v[v.size() / 2];
+    const size_t i = size_t(q * double(v.size() - 1));
+    std::nth_element(v.begin(), v.begin() + long(i), v.end());
+    return v[i];
 }
 
-// Median residual of local quadratic fits over k-neighbourhoods, and their median radius.
-void measure(const PointSet &points, size_t k, Progress &progress, double &noise, double &radius) {
+// The kQuantile-quantile of √(χ²_ν / ν) (Wilson–Hilferty): what that quantile of unbiased
+// RMS residuals with ν degrees of freedom reads for unit noise.
+double chi_quantile(double dof) {
+    const double a = 2.0 / (9.0 * dof);
+    return std::pow(std::max(0.0, 1.0 - a + kQuantileZ * std::sqrt(a)), 1.5);
+}
+
+// Least-squares height w = a u² + b uv + c v² + d u + e v + f (or only its affine part when
+// `terms` is 3) over fit; returns the residuals of all of pts. `scale` balances the normal
+// equations.
+void fit_height(const std::vector<Local> &fit, int terms, double scale, const std::vector<Local> &pts,
+                std::vector<double> &residuals) {
+    const double inv = 1.0 / scale;
+    using Vec = Eigen::Matrix<double, 6, 1>;
+    auto row = [&](const Local &p) {
+        double u = p.u * inv, v = p.v * inv;
+        Vec r;
+        if (terms == 6) r << u * u, u * v, v * v, u, v, 1.0;
+        else r << 0.0, 0.0, 0.0, u, v, 1.0;
+        return r;
+    };
+    Eigen::Matrix<double, 6, 6> m = Eigen::Matrix<double, 6, 6>::Zero();
+    Vec rhs = Vec::Zero();
+    for (const Local &p : fit) {
+        Vec r = row(p);
+        m.noalias() += r * r.transpose();
+        rhs += r * p.w;
+    }
+    m.diagonal().array() += 1e-9 * (1.0 + m.trace() / 6.0);
+    Vec k = m.ldlt().solve(rhs);
+    if (!k.allFinite()) k.setZero();
+    residuals.resize(pts.size());
+    for (size_t i = 0; i < pts.size(); ++i) residuals[i] = pts[i].w - row(pts[i]).dot(k);
+}
+
+double unbiased_rms(const std::vector<double> &residuals, size_t count) {
+    double sum = 0.0;
+    for (size_t i = 0; i < count; ++i) sum += residuals[i] * residuals[i];
+    return std::sqrt(sum / double(count - 6));
+}
+
+// The best split of residuals[0, count) into two groups (1D two-means): the threshold
+// between them and how many pooled standard deviations apart their means are.
+double two_means(const std::vector<double> &residuals, size_t count, double &separation) {
+    std::vector<double> s(residuals.begin(), residuals.begin() + long(count));
+    std::sort(s.begin(), s.end());
+    std::vector<double> sum(count + 1, 0.0), sq(count + 1, 0.0);
+    for (size_t i = 0; i < count; ++i) {
+        sum[i + 1] = sum[i] + s[i];
+        sq[i + 1] = sq[i] + s[i] * s[i];
+    }
+    double best = INFINITY, threshold = 0.0;
+    separation = 0.0;
+    for (size_t k = kSheetMinSide; k + kSheetMinSide <= count; ++k) {
+        double n1 = double(k), n2 = double(count - k);
+        double m1 = sum[k] / n1, m2 = (sum[count] - sum[k]) / n2;
+        double ss1 = std::max(0.0, sq[k] - n1 * m1 * m1), ss2 = std::max(0.0, sq[count] - sq[k] - n2 * m2 * m2);
+        if (ss1 + ss2 < best) {
+            best = ss1 + ss2;
+            double pooled = std::sqrt((ss1 + ss2) / double(count - 2));
+            separation = pooled > 0.0 ? (m2 - m1) / pooled : INFINITY;
+            threshold = 0.5 * (s[k - 1] + s[k]);
+        }
+    }
+    return threshold;
+}
+
+// Keeps the points of pts on the centre's sheet (pts[0] is the centre) when the nearest
+// kFar hold two. A fit through both sheets lies between them and is tilted by whichever
+// holds more points, which blurs the two groups of residuals; refitted to the centre's
+// group alone, the other sheet stands a full wall thickness off, while a noisy single sheet
+// still reads as one group.
+void keep_centre_sheet(std::vector<Local> &pts, double scale) {
+    thread_local std::vector<double> residuals;
+    thread_local std::vector<Local> side;
+    fit_height(std::vector<Local>(pts.begin(), pts.begin() + long(kFar)), 6, scale, pts, residuals);
+    double separation;
+    double split = two_means(residuals, kFar, separation);
+    side.clear();
+    for (size_t k = 0; k < kFar; ++k)
+        if ((residuals[k] > split) == (residuals[0] > split)) side.push_back(pts[k]);
+    fit_height(side, side.size() >= 12 ? 6 : 3, scale, pts, residuals);
+    split = two_means(residuals, kFar, separation);
+    if (!(separation > kSheetSeparation)) return;
+    size_t kept = 0;
+    const bool above = residuals[0] > split;
+    for (size_t k = 0; k < pts.size(); ++k)
+        if ((residuals[k] > split) == above) pts[kept++] = pts[k];
+    pts.resize(kept);
+}
+
+struct Scales {
+    double near = 0.0, far = 0.0;  // median unbiased RMS residual at kNear and kFar
+    double ball = 0.0;             // median ball radius
+};
+
+Scales measure(const PointSet &points, size_t ball, size_t centres, Progress &progress) {
     const size_t n = points.size();
-    const size_t step = std::max<size_t>(1, n / kSamples);
-    std::vector<double> rms, radii;
+    const size_t step = std::max<size_t>(1, n / centres);
+    std::vector<double> near, far, radii, residuals;
     std::vector<uint32_t> idx;
     std::vector<float> d2;
     PointList local;
+    std::vector<Local> pts;
     for (size_t i = 0; i < n; i += step) {
         progress.tick();
         const Eigen::Vector3d centre = points.point(i);
-        points.nearest(centre, k, idx, d2);
-        if (idx.size() < 10) continue;
-        local.clear();
-        for (uint32_t j : idx) local.push_back(points.point(j) - centre);
+        points.nearest(centre, ball, idx, d2);
+        if (idx.size() < kFar) continue;
         const double r = std::sqrt(double(d2.back()));
         if (!(r > 0.0)) continue;
-        Pca pca = compute_pca(local);
-        Quadric q = fit_bivariate(local, pca, r);
-        double sum = 0.0;
-        for (const auto &p : local) sum += q.value(p) * q.value(p) / std::max(1e-24, q.gradient(p).squaredNorm());
-        // Unbiased for the 6 fitted coefficients.
-        rms.push_back(std::sqrt(sum / double(local.size() - 6)));
+        local.clear();
+        for (uint32_t j : idx) local.push_back(points.point(j) - centre);
+        const Pca pca = compute_pca(local);
+        const Eigen::Vector3d t1 = pca.axes.col(2), t2 = pca.axes.col(1), nrm = pca.axes.col(0);
+        pts.clear();
+        for (const auto &p : local) {
+            double u = p.dot(t1), v = p.dot(t2);
+            pts.push_back({u, v, p.dot(nrm), u * u + v * v});
+        }
+        auto by_tangential = [](const Local &a, const Local &b) { return a.t2 < b.t2; };
+        std::sort(pts.begin(), pts.end(), by_tangential);
+        keep_centre_sheet(pts, r);
+        if (pts.size() < kFar) continue;
+        fit_height(std::vector<Local>(pts.begin(), pts.begin() + long(kNear)), 6, r, pts, residuals);
+        near.push_back(unbiased_rms(residuals, kNear));
+        fit_height(std::vector<Local>(pts.begin(), pts.begin() + long(kFar)), 6, r, pts, residuals);
+        far.push_back(unbiased_rms(residuals, kFar));
         radii.push_back(r);
     }
-    noise = median(rms);
-    radius = median(radii);
+    Scales s;
+    s.near = quantile(near, kQuantile) / chi_quantile(double(kNear - 6));
+    s.far = quantile(far, kQuantile) / chi_quantile(double(kFar - 6));
+    s.ball = quantile(radii, 0.5);
+    return s;
 }
+
+// Noise is what the two scales share: σ² = 2 near² − far² cancels a residual that grows
+// at least in proportion to the neighbourhood's area (shape, sampling), and leaves noise,
+// which is the same at both.
+double noise_of(const Scales &s) { return std::sqrt(std::max(0.0, 2.0 * s.near * s.near - s.far * s.far)); }
+
 }  // namespace
 
 double estimate_noise(const PointSet &points, Progress &progress) {
-    double noise, radius;
-    measure(points, kNeighbours, progress, noise, radius);
-    if (radius > 0.0 && noise > kHeavyNoise * radius && points.size() > 4 * kWideNeighbours) {
-        double wide, wide_radius;
-        measure(points, kWideNeighbours, progress, wide, wide_radius);
-        noise = std::max(noise, wide);
+    size_t ball = std::min(kBall, points.size());
+    if (ball < kFar) return 0.0;
+    Scales s = measure(points, ball, kCentres, progress);
+    double noise = noise_of(s);
+    // Heavy noise: a ball only a few σ high cuts the noise's tails; measure again in a ball
+    // tall enough (radius ∝ √points on a surface).
+    if (s.ball > 0.0 && noise * kBallPerNoise > s.ball) {
+        double want = std::pow(noise * kBallPerNoise / s.ball, 2.0) * double(ball);
+        size_t wider = std::min({kMaxBall, points.size(), size_t(want)});
+        // Fewer centres keep the cost of the taller balls bounded.
+        if (wider > ball) {
+            const size_t centres = std::max(kMinCentres, kCentres * ball / wider);
+            noise = std::max(noise, noise_of(measure(points, wider, centres, progress)));
+        }
     }
     return noise;
 }

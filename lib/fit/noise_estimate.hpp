@@ -1,9 +1,13 @@
-// Estimate of the sampling noise: the median, over a sample of points, of the RMS residual
-// of a bivariate quadratic fitted to each point's neighbourhood. A quadratic absorbs the
-// surface's curvature, so on clean data the residual is near zero and on noisy data it is
-// about the noise's standard deviation. Subdividing until the Taubin error is below the
-// noise level only fits the noise (MPU's known weakness on noisy scans), so fit uses it as a
-// floor for ε.
+// Estimate of the sampling noise σ. Around sampled centres, a height quadratic is fitted in
+// the tangent plane to the 12 and the 24 nearest neighbours (nearest along the plane, taken
+// from a ball several σ tall, so that the noise's tails are not cut off). What the shape
+// leaves (curvature, creases, detail too fine for the sampling) grows from the smaller
+// neighbourhood to the larger one; noise does not, so the two are combined to cancel the
+// first. A neighbourhood holding two sheets (a thin wall) is cut to the centre's sheet, and
+// the residuals are read at a low quantile over the centres, with the correction that the
+// quantile of a χ distribution implies: shape residual is where the detail is, noise is
+// everywhere. Subdividing until the Taubin error is below the noise level only fits the
+// noise (MPU's known weakness on noisy scans), so fit uses it as a floor for ε.
 #pragma once
 
 #include "core/progress.hpp"
@@ -11,7 +15,7 @@
 
 namespace gmpu {
 
-// σ̂ in the normalised frame. Runs on the calling thread; polls progress per sample.
+// σ̂ in the normalised frame. Runs on the calling thread; polls progress per centre.
 double estimate_noise(const PointSet &points, Progress &progress);
 
 }  // namespace gmpu
