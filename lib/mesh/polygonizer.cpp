@@ -21,6 +21,8 @@ constexpr int B = BlockGrid::B;
 // to be kept: a real part holds at least the N_min (15) points one local fit needs; a
 // bubble of the far field or a stray quadric sheet holds none or a few noisy ones.
 constexpr uint32_t kMinVotes = 15;
+// Grid cube as a share of the gap between two sheets fitted in one leaf.
+constexpr double kCubesPerGap = 0.4;
 
 struct BlockOutput {
     std::vector<uint64_t> vertex_key;         // grid edge per vertex: corner id × 8 + direction
@@ -251,13 +253,23 @@ Mesh weld(std::vector<BlockOutput> &blocks, const Normalisation &norm, Progress 
 
 int default_resolution(const Octree &tree) {
     // Half the median size of the leaves that hold points: the grid then resolves every
-    // local fit with about two cubes across.
-    std::vector<double> sizes;
-    for (const Cell &c : tree.cells)
-        if (c.is_leaf() && c.point_end > c.point_begin) sizes.push_back(c.size);
+    // local fit with about two cubes across. Where a leaf holds two sheets, the cube must
+    // also be well under their gap, or both sheets fall between two grid corners of the same
+    // sign and vanish; the thinnest walls (a low quantile, not one stray leaf) set it.
+    std::vector<double> sizes, gaps;
+    for (const Cell &c : tree.cells) {
+        if (!c.is_leaf() || c.point_end == c.point_begin) continue;
+        sizes.push_back(c.size);
+        if (c.shape.model == Model::two_sheets) gaps.push_back(tree.pieces[size_t(c.shape.piece)].sheet_gap());
+    }
     if (sizes.empty()) return 64;
     std::nth_element(sizes.begin(), sizes.begin() + long(sizes.size() / 2), sizes.end());
-    const double h = 0.5 * sizes[sizes.size() / 2];
+    double h = 0.5 * sizes[sizes.size() / 2];
+    if (!gaps.empty()) {
+        const size_t q = gaps.size() / 10;
+        std::nth_element(gaps.begin(), gaps.begin() + long(q), gaps.end());
+        h = std::min(h, kCubesPerGap * gaps[q]);
+    }
     return std::clamp(int(std::ceil(1.0 / h)), 32, 1024);
 }
 
