@@ -316,7 +316,9 @@ GMPU_API gmpu_status gmpu_surface_get_stat(const gmpu_surface *s, gmpu_stat key,
                 *value = leaves_where([](const gmpu::Cell &c) { return c.shape.model == gmpu::Model::bivariate; });
                 break;
             case GMPU_STAT_PIECEWISE_CELLS:
-                *value = leaves_where([](const gmpu::Cell &c) { return c.shape.piece >= 0; });
+                *value = leaves_where([](const gmpu::Cell &c) {
+                    return c.shape.model == gmpu::Model::edge || c.shape.model == gmpu::Model::corner;
+                });
                 break;
             case GMPU_STAT_COMPONENTS: *value = s->orient_stats.components; break;
             case GMPU_STAT_FLIPPED_CELLS: *value = s->orient_stats.flipped_leaves; break;

@@ -25,13 +25,14 @@ struct Builder {
     const PointSet &points;
     const Params &params;
     double epsilon;  // ε in normalised units
+    double requested;  // the caller's ε, before the noise floor
     Progress &progress;
     Octree tree;
 
     double support_radius(double size) const { return params.support_scale * std::sqrt(3.0) * size; }
 
     bool should_subdivide(const Cell &c) const {
-        return c.error > epsilon && c.depth < params.max_depth &&
+        return (c.error > epsilon || c.unresolved_sheets) && c.depth < params.max_depth &&
                c.initial_count >= uint32_t(params.min_points);
     }
 
@@ -70,12 +71,13 @@ struct Builder {
         }
         support.resize(idx.size());
         for (size_t k = 0; k < idx.size(); ++k) support[k] = points.point(idx[k]) - c.centre;
-        CellFit f = fit_cell(support, c.radius, epsilon, params);
+        CellFit f = fit_cell(support, c.radius, epsilon, requested, params);
+        c.unresolved_sheets = f.unresolved_sheets;
         c.support_count = uint32_t(std::max(double(idx.size()), estimate));
         c.error = float(f.error);
         c.variation = float(f.variation);
         c.shape = f.shape;
-        if (f.shape.model == Model::edge || f.shape.model == Model::corner) {
+        if (is_piecewise(f.shape.model)) {
             c.shape.piece = -2;  // resolved to a table index when appended (single-threaded)
             piece = f.piece;
         }
@@ -185,7 +187,8 @@ struct Builder {
                 uint32_t parent = level[i];
                 if (kids[i].empty()) {  // stays a leaf, although its fit misses ε
                     Cell &stranded = tree.cells[parent];
-                    stranded.blend_factor = float(std::pow(epsilon / double(stranded.error), kStrandedPower));
+                    stranded.blend_factor =
+                        float(std::min(1.0, std::pow(epsilon / double(stranded.error), kStrandedPower)));
                     continue;
                 }
                 tree.cells[parent].first_child = int32_t(tree.cells.size());
@@ -218,13 +221,18 @@ struct Builder {
 
 }  // namespace
 
+namespace {
+double requested_epsilon(const PointSet &points, const Params &params) {
+    return params.error * points.world_diagonal() * points.normalisation().scale;
+}
+}  // namespace
+
 double effective_epsilon(const PointSet &points, const Params &params, double noise) {
-    const double requested = params.error * points.world_diagonal() * points.normalisation().scale;
-    return std::max(requested, params.noise_scale * noise);
+    return std::max(requested_epsilon(points, params), params.noise_scale * noise);
 }
 
 Octree build_octree(const PointSet &points, const Params &params, double epsilon, Progress &progress) {
-    Builder b{points, params, epsilon, progress, {}};
+    Builder b{points, params, epsilon, std::min(epsilon, requested_epsilon(points, params)), progress, {}};
     return b.run();
 }
 

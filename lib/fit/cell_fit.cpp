@@ -1,6 +1,7 @@
 #include "fit/cell_fit.hpp"
 
 #include "fit/piecewise_fit.hpp"
+#include "fit/two_sheet_fit.hpp"
 
 namespace gmpu {
 
@@ -21,7 +22,7 @@ const PointList &fit_sample(const PointList &support, PointList &buffer) {
 }
 }  // namespace
 
-CellFit fit_cell(const PointList &support, double radius, double epsilon, const Params &params) {
+CellFit fit_cell(const PointList &support, double radius, double epsilon, double requested, const Params &params) {
     thread_local PointList sample_buffer;
     const PointList &sample = fit_sample(support, sample_buffer);
     static const std::vector<PiecewiseShape> no_pieces;
@@ -37,6 +38,14 @@ CellFit fit_cell(const PointList &support, double radius, double epsilon, const 
         fit.shape.q = fit_bivariate(sample, pca, radius);
     }
     fit.error = taubin_error(fit.shape, no_pieces, support);
+
+    if (fit.error > std::min(epsilon, requested)) {
+        CellFit two;
+        two.variation = fit.variation;
+        const SheetSplit split = fit_two_sheets(support, fit.shape, fit.error, radius, two);
+        if (two.shape.model == Model::two_sheets) return two;
+        fit.unresolved_sheets = split.found;
+    }
 
     if (fit.error > epsilon && params.sharp_features && support.size() <= kMaxSharpSupport) {
         CellFit sharp;

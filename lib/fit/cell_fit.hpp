@@ -15,10 +15,15 @@ struct CellFit {
     PiecewiseShape piece;  // valid when shape.model is edge or corner
     double error = 0.0;    // Taubin distance error on the support points
     double variation = 0.0;
+    // Two sheets were seen in the support but no model here fits them: the cell must be
+    // split whatever its error (its single fit passes between the sheets).
+    bool unresolved_sheets = false;
 };
 
 // `support` holds the support points relative to the cell centre, `radius` is R.
-// `epsilon` is ε in the same (normalised) units.
-CellFit fit_cell(const PointList &support, double radius, double epsilon, const Params &params);
+// `epsilon` is ε in the same (normalised) units, `requested` the caller's ε before the noise
+// floor raised it: a fit worse than that is checked for two sheets (two_sheet_fit.hpp),
+// whose clean separation shows that the floor, not the data, let the fit pass.
+CellFit fit_cell(const PointList &support, double radius, double epsilon, double requested, const Params &params);
 
 }  // namespace gmpu

@@ -35,6 +35,7 @@ struct Cell {
     float variation = 0.0f;           // PCA surface variation σ of the support
     int8_t sign = 1;                  // orientation label ℓ_i applied to the shape
     bool oriented = false;
+    bool unresolved_sheets = false;   // fit saw two sheets it could not model: split anyway
     // Factor on the cell's partition-of-unity weight: 1, except for a leaf whose fit misses
     // ε but which could not be split because no child would be near the data (see
     // build_octree.cpp): its coarse fit is unreliable wherever a finer leaf has a say.

@@ -21,6 +21,10 @@ constexpr int B = BlockGrid::B;
 // to be kept: a real part holds at least the N_min (15) points one local fit needs; a
 // bubble of the far field or a stray quadric sheet holds none or a few noisy ones.
 constexpr uint32_t kMinVotes = 15;
+// Grid cube as a share of the gap between two sheets fitted in one leaf.
+constexpr double kCubesPerGap = 0.4;
+// Share of the points that two-sheet leaves must hold for their gap to set the grid.
+constexpr double kWallShare = 0.1;
 
 struct BlockOutput {
     std::vector<uint64_t> vertex_key;         // grid edge per vertex: corner id × 8 + direction
@@ -265,13 +269,30 @@ Mesh weld(std::vector<BlockOutput> &blocks, const Normalisation &norm, Progress 
 
 int default_resolution(const Octree &tree) {
     // Half the median size of the leaves that hold points: the grid then resolves every
-    // local fit with about two cubes across.
+    // local fit with about two cubes across. Where leaves hold two sheets, the cube must
+    // also be well under their gap, or both sheets fall between two grid corners of the same
+    // sign and vanish. The walls that set it must hold a real share of the points: a few
+    // two-sheet leaves in a narrow slot would otherwise refine the whole grid.
     std::vector<double> sizes;
-    for (const Cell &c : tree.cells)
-        if (c.is_leaf() && c.point_end > c.point_begin) sizes.push_back(c.size);
+    std::vector<std::pair<double, uint32_t>> walls;  // gap, points
+    double points = 0.0;
+    for (const Cell &c : tree.cells) {
+        if (!c.is_leaf() || c.point_end == c.point_begin) continue;
+        sizes.push_back(c.size);
+        points += double(c.point_end - c.point_begin);
+        if (c.shape.model == Model::two_sheets)
+            walls.push_back({tree.pieces[size_t(c.shape.piece)].sheet_gap(), c.point_end - c.point_begin});
+    }
     if (sizes.empty()) return 64;
     std::nth_element(sizes.begin(), sizes.begin() + long(sizes.size() / 2), sizes.end());
-    const double h = 0.5 * sizes[sizes.size() / 2];
+    double h = 0.5 * sizes[sizes.size() / 2];
+    std::sort(walls.begin(), walls.end());
+    double held = 0.0;
+    for (const auto &w : walls)
+        if ((held += w.second) >= kWallShare * points) {
+            h = std::min(h, kCubesPerGap * w.first);
+            break;
+        }
     return std::clamp(int(std::ceil(1.0 / h)), 32, 1024);
 }
 

@@ -126,6 +126,33 @@ void thin_plate(void **) {
     check_signs(r, shape, {{0, 0, 0}, {0.5, -0.5, 0.01}, {0, 0, 0.1}, {0, 0, -0.1}, {0.9, 0.9, 0}});
 }
 
+void hollow_sphere(void **) {
+    // A wall 1.2 % of the diagonal thick, under two sample spacings: every support holds
+    // both sheets, and one quadric per cell would make a single sheet in the middle of the
+    // wall (orientation ~50 %, one component). Two sheets fitted per cell keep both.
+    const double outer = 1.0, wall = 0.012 * 2 * std::sqrt(3.0) * outer;
+    NestedSpheres shape({0, 0, 0}, outer - wall, outer);
+    Reconstruction r = check_shape(shape, 20000, {2, 0, 0.995, 0.001, 0.01});
+    check_signs(r, shape, {{0, 0, 0}, {0.979, 0, 0}, {0, -0.979, 0}, {0, 0, 1.02}, {0, 0, 0.93}});
+}
+
+void sparse_thin_plate(void **) {
+    // 1,000 points on a plate 1.2 % of the diagonal thick (about a tenth of the sample
+    // spacing): each sheet is the other's nearest data, which reads as noise; two sheets
+    // must still be seen through the raised noise floor.
+    Plate shape({0, 0, 0}, {1.0, 1.0, 0.012 * std::sqrt(8.0) / 2});
+    OrientedPoints pts = shape.sample(1000, 5);
+    Reconstruction r = reconstruct(pts.positions);
+    assert_int_equal(r.status, GMPU_OK);
+    MeshCheck check = check_mesh(r.mesh);
+    assert_true(check.watertight);
+    assert_int_equal(check.components, 1);
+    const double accuracy = orientation_accuracy(r.normals, pts.normals).accuracy;
+    fprintf(stderr, "  orientation %.2f%%\n", 100 * accuracy);
+    assert_true(accuracy >= 0.97);
+    check_signs(r, shape, {{0, 0, 0}, {0.5, -0.5, 0}, {0, 0, 0.05}, {0, 0, -0.05}});
+}
+
 void cube(void **) {
     // Sharp edges and corners. Beside a corner, coarse cells with no point in their cube
     // fit the two or three faces with one quadric that misses ε by far; at full weight they
@@ -363,6 +390,8 @@ int main(void) {
         cmocka_unit_test(torus),
         cmocka_unit_test(nested_spheres),
         cmocka_unit_test(thin_plate),
+        cmocka_unit_test(hollow_sphere),
+        cmocka_unit_test(sparse_thin_plate),
         cmocka_unit_test(cube),
         cmocka_unit_test(islands),
         cmocka_unit_test(scale_invariance),

@@ -1,0 +1,142 @@
+#include "fit/two_sheet_fit.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace gmpu {
+
+namespace {
+
+// The groups' means must be this many pooled standard deviations apart. A smooth surface
+// that one model fits badly (a wave across the support) spreads its distances evenly, with
+// its two halves about 4 deviations apart; Gaussian noise split at its mean, about 2.7.
+constexpr double kSeparation = 6.0;
+// Residuals are looked at on an even subsample of the support (the split needs no more).
+constexpr size_t kMaxSamples = 512;
+// A group this small gets no quadratic of its own: its sheet is the other one, offset.
+constexpr size_t kOwnFitPoints = 12;
+// The two-sheet model must beat the single fit by this factor to replace it.
+constexpr double kImprovement = 0.5;
+// Points of one sheet must lie this share of the gap inside the other sheet's positive side,
+// or the sheets cross within the support.
+constexpr double kClearance = 0.25;
+
+struct Groups {
+    double threshold = 0.0, gap = 0.0, spread = 0.0;
+    size_t smaller = 0;
+};
+
+// Otsu's split of the sorted values: the threshold maximising the between-group variance,
+// each group holding at least `min_group` values.
+Groups otsu(std::vector<double> &r, size_t min_group) {
+    Groups g;
+    std::sort(r.begin(), r.end());
+    const size_t n = r.size();
+    std::vector<double> s(n + 1, 0.0), s2(n + 1, 0.0);
+    for (size_t i = 0; i < n; ++i) s[i + 1] = s[i] + r[i], s2[i + 1] = s2[i] + r[i] * r[i];
+    double best = -1.0;
+    size_t k_best = 0;
+    for (size_t k = min_group; k + min_group <= n; ++k) {
+        const double m0 = s[k] / double(k), m1 = (s[n] - s[k]) / double(n - k);
+        const double between = double(k) * double(n - k) * (m1 - m0) * (m1 - m0);
+        if (between > best) best = between, k_best = k;
+    }
+    if (k_best == 0) return g;
+    const size_t k = k_best;
+    const double m0 = s[k] / double(k), m1 = (s[n] - s[k]) / double(n - k);
+    const double ss0 = s2[k] - double(k) * m0 * m0, ss1 = (s2[n] - s2[k]) - double(n - k) * m1 * m1;
+    g.threshold = 0.5 * (r[k - 1] + r[k]);
+    g.gap = m1 - m0;
+    g.spread = std::sqrt(std::max(0.0, ss0 + ss1) / double(n));
+    g.smaller = std::min(k, n - k);
+    return g;
+}
+
+double signed_distance(const Quadric &q, const Eigen::Vector3d &p) {
+    const double gn = q.gradient(p).norm();
+    return gn > 1e-12 ? q.value(p) / gn : 0.0;
+}
+
+// Fits each sheet in the frame of the larger group (offsetting the larger sheet for a group
+// too small for its own quadratic), then re-assigns points to the nearer sheet.
+bool fit_sheets(const PointList &pts, std::vector<int> &label, double radius, Quadric part[2]) {
+    PointList group[2];
+    for (int round = 0; round < 3; ++round) {
+        group[0].clear(), group[1].clear();
+        for (size_t i = 0; i < pts.size(); ++i) group[label[i]].push_back(pts[i]);
+        const int big = group[0].size() >= group[1].size() ? 0 : 1, small = 1 - big;
+        if (group[small].empty()) return false;
+        const Pca frame = compute_pca(group[big]);
+        part[big] = fit_bivariate(group[big], frame, radius);
+        if (group[small].size() >= kOwnFitPoints) {
+            part[small] = fit_bivariate(group[small], frame, radius);
+        } else {
+            std::vector<double> offset;
+            for (const auto &p : group[small]) offset.push_back(part[big].value(p));
+            std::nth_element(offset.begin(), offset.begin() + long(offset.size() / 2), offset.end());
+            part[small] = part[big];
+            part[small].c -= offset[offset.size() / 2];
+        }
+        if (round == 2) break;
+        for (size_t i = 0; i < pts.size(); ++i)
+            label[i] = std::abs(signed_distance(part[1], pts[i])) < std::abs(signed_distance(part[0], pts[i]));
+    }
+    // Each part positive towards the other sheet; every point of that sheet well inside.
+    double gap = 0.0;
+    for (int c = 0; c < 2; ++c) {
+        const PointList &other = group[1 - c];
+        double sum = 0.0;
+        for (const auto &p : other) sum += signed_distance(part[c], p);
+        if (sum < 0.0) part[c] *= -1.0;
+        gap += std::abs(sum) / double(other.size());
+    }
+    gap *= 0.5;
+    for (int c = 0; c < 2; ++c)
+        for (const auto &p : group[1 - c])
+            if (signed_distance(part[c], p) < kClearance * gap) return false;
+    return true;
+}
+
+}  // namespace
+
+SheetSplit fit_two_sheets(const PointList &support, const LocalShape &single, double single_error, double radius,
+                          CellFit &out) {
+    SheetSplit split;
+    static const std::vector<PiecewiseShape> no_pieces;
+    PointList pts;
+    const double step = std::max(1.0, double(support.size()) / double(kMaxSamples));
+    for (double k = 0; size_t(k) < support.size(); k += step) pts.push_back(support[size_t(k)]);
+    const size_t min_group = std::max<size_t>(4, pts.size() / 20);
+    if (pts.size() < 2 * min_group) return split;
+
+    std::vector<double> r(pts.size());
+    Eigen::Vector3d g;
+    for (size_t i = 0; i < pts.size(); ++i) {
+        const double v = single.value(pts[i], no_pieces, &g), gn = g.norm();
+        r[i] = gn > 1e-12 ? v / gn : 0.0;
+    }
+    std::vector<double> sorted = r;
+    const Groups groups = otsu(sorted, min_group);
+    if (!(groups.gap > 1e-9 * radius) || groups.gap < kSeparation * groups.spread) return split;
+    split.found = true;
+    split.gap = groups.gap;
+
+    std::vector<int> label(pts.size());
+    for (size_t i = 0; i < pts.size(); ++i) label[i] = r[i] > groups.threshold;
+    PiecewiseShape shape;
+    if (!fit_sheets(pts, label, radius, shape.part)) return split;
+    shape.count = 2;
+    const std::vector<PiecewiseShape> table{shape};
+    LocalShape local;
+    local.model = Model::two_sheets;
+    local.piece = 0;
+    local.q = shape.part[0];  // a smooth stand-in, never used while piece ≥ 0
+    const double error = taubin_error(local, table, support);
+    if (!(error < kImprovement * single_error)) return split;
+    out.shape = local;
+    out.piece = shape;
+    out.error = error;
+    return split;
+}
+
+}  // namespace gmpu

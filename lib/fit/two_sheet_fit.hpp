@@ -1,0 +1,24 @@
+// Two sheets in one support: a thin wall, or the two sides of a narrow gap, closer together
+// than the support is wide. A single smooth model can only pass between them, and the blend
+// of such fits makes one sheet in the middle of the wall. The two sheets show as a bimodal
+// distribution of the single fit's signed distances; they are then fitted as
+// min(w − h0(u, v), h1(u, v) − w) in one frame (h0 below h1): positive between the sheets,
+// zero on each, unit gradient, stored like a piecewise edge with two parts.
+#pragma once
+
+#include "fit/cell_fit.hpp"
+
+namespace gmpu {
+
+struct SheetSplit {
+    bool found = false;  // the single fit's distances form two well-separated groups
+    double gap = 0.0;    // distance between the groups' means
+};
+
+// Looks for two sheets in `support` around the fitted `single` shape. Fills `out` with the
+// two-sheet model when one fits (its error below the single fit's); the split tells
+// whether two sheets were seen at all, fitted or not.
+SheetSplit fit_two_sheets(const PointList &support, const LocalShape &single, double single_error, double radius,
+                          CellFit &out);
+
+}  // namespace gmpu
