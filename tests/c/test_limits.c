@@ -1,7 +1,8 @@
 /* Resource caps through the C ABI: GMPU_PARAM_MAX_CELLS and GMPU_PARAM_MAX_TRIANGLES fail
  * cleanly with GMPU_ERROR_LIMIT_EXCEEDED exactly past the cap (the cap itself is allowed),
  * quickly, without keeping a partial result, and leave the handle usable;
- * GMPU_PARAM_MAX_DEPTH caps GMPU_STAT_DEPTH. */
+ * GMPU_PARAM_MAX_DEPTH caps GMPU_STAT_DEPTH; a process limit that refuses worker threads
+ * costs parallelism, never the process or the result. */
 #define _GNU_SOURCE
 #include <setjmp.h>
 #include <stdarg.h>
@@ -14,6 +15,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "gmpu/gmpu.h"
 #include "robust_util.h"
@@ -218,12 +222,68 @@ static void test_memory_returned(void **state) {
         fail_msg("%.1f of %.1f MB still resident after destroy", (after - before) / 1e6, (alive - before) / 1e6);
 }
 
+/* The mesh of g_bumpy with `threads` workers (resolution 40). */
+static gmpu_mesh *bumpy_mesh(unsigned threads, gmpu_status *status) {
+    gmpu_surface *s = surface_with_points();
+    gmpu_mesh *m = NULL;
+    *status = gmpu_surface_set_param(s, GMPU_PARAM_THREADS, threads);
+    if (*status == GMPU_OK) *status = gmpu_surface_fit(s);
+    if (*status == GMPU_OK) *status = gmpu_surface_orient(s);
+    if (*status == GMPU_OK) *status = gmpu_surface_polygonize(s, &m);
+    gmpu_surface_destroy(s);
+    return m;
+}
+
+static int same_mesh(const gmpu_mesh *a, const gmpu_mesh *b) {
+    const size_t nv = gmpu_mesh_vertex_count(a), nt = gmpu_mesh_triangle_count(a);
+    return nv == gmpu_mesh_vertex_count(b) && nt == gmpu_mesh_triangle_count(b) &&
+           memcmp(gmpu_mesh_vertices(a), gmpu_mesh_vertices(b), 3 * nv * sizeof(double)) == 0 &&
+           memcmp(gmpu_mesh_triangles(a), gmpu_mesh_triangles(b), 3 * nt * sizeof(uint32_t)) == 0;
+}
+
+/* A process limit (a container's pids cap, `ulimit -u`) makes thread creation fail part way
+ * through a stage's pool. The stage must go on with the threads it got, join them, and give
+ * the same mesh as one thread; it used to terminate the process. Each limit runs in a forked
+ * child under RLIMIT_NPROC; root ignores that limit, so a root child first becomes nobody
+ * (which owns no other task here: a limit of k leaves room for k - 1 workers). */
+static void test_thread_creation_refused(void **state) {
+    (void)state;
+    gmpu_status status;
+    gmpu_mesh *reference = bumpy_mesh(1, &status);
+    assert_ok(status);
+    const rlim_t limits[] = {1, 2, 3, 5};
+    for (size_t k = 0; k < sizeof limits / sizeof *limits; ++k) {
+        fflush(NULL);
+        pid_t pid = fork();
+        assert_true(pid >= 0);
+        if (pid == 0) {
+            if (geteuid() == 0 && (setgid(65534) != 0 || setuid(65534) != 0)) _exit(10);
+            struct rlimit lim = {limits[k], limits[k]};
+            if (setrlimit(RLIMIT_NPROC, &lim) != 0) _exit(11);
+            gmpu_mesh *m = bumpy_mesh(16, &status);
+            int code = status != GMPU_OK ? 12 : same_mesh(m, reference) ? 0 : 13;
+            if (code) fprintf(stderr, "limit %d: %s\n", (int)limits[k], gmpu_last_error());
+            gmpu_mesh_destroy(m);
+            _exit(code); /* skips the leak checker's exit thread, which the limit refuses */
+        }
+        int wstatus = 0;
+        assert_true(waitpid(pid, &wstatus, 0) == pid);
+        if (WIFSIGNALED(wstatus))
+            fail_msg("RLIMIT_NPROC %d: the child died of signal %d", (int)limits[k], WTERMSIG(wstatus));
+        if (WEXITSTATUS(wstatus) != 0)
+            fail_msg("RLIMIT_NPROC %d: child exit %d (12: failed, 13: another mesh)", (int)limits[k],
+                     WEXITSTATUS(wstatus));
+    }
+    gmpu_mesh_destroy(reference);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_max_cells),
         cmocka_unit_test(test_max_triangles),
         cmocka_unit_test(test_max_depth),
         cmocka_unit_test(test_memory_returned),
+        cmocka_unit_test(test_thread_creation_refused),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
