@@ -50,9 +50,9 @@
  * library at run time. GMPU_ABI_VERSION changes only when the ABI breaks (it is the
  * SONAME's number: libgmpu.so.1). */
 #define GMPU_VERSION_MAJOR 0
-#define GMPU_VERSION_MINOR 1
+#define GMPU_VERSION_MINOR 2
 #define GMPU_VERSION_PATCH 0
-#define GMPU_VERSION_NUMBER 100 /* MAJOR*10000 + MINOR*100 + PATCH */
+#define GMPU_VERSION_NUMBER 200 /* MAJOR*10000 + MINOR*100 + PATCH */
 #define GMPU_ABI_VERSION 1
 
 #ifdef __cplusplus
@@ -77,12 +77,13 @@ typedef enum gmpu_status {
     GMPU_ERROR_DEGENERATE_INPUT = 3, /* identical, collinear or coplanar points: no solid */
     GMPU_ERROR_WRONG_ORDER = 4,      /* a stage called before the one it needs */
     GMPU_ERROR_OUT_OF_MEMORY = 5,
-    GMPU_ERROR_LIMIT_EXCEEDED = 6,   /* GMPU_PARAM_MAX_CELLS or the triangle cap was hit */
+    GMPU_ERROR_LIMIT_EXCEEDED = 6,   /* a cap (cells, triangles, memory budget) was hit */
     GMPU_ERROR_CANCELLED = 7,        /* the progress callback returned non-zero */
     GMPU_ERROR_IO = 8,               /* a file could not be opened, read or written */
     GMPU_ERROR_PARSE = 9,            /* a file's contents are malformed or truncated */
     GMPU_ERROR_UNSUPPORTED = 10,     /* unknown file extension or format variant */
-    GMPU_ERROR_INTERNAL = 11         /* a bug: please report it with the message */
+    GMPU_ERROR_INTERNAL = 11,        /* a bug: please report it with the message */
+    GMPU_ERROR_BUSY = 12             /* a call on a surface from its own progress callback */
 } gmpu_status;
 
 /* The enumerator's name ("GMPU_ERROR_CANCELLED"), or "GMPU_UNKNOWN_STATUS". Never NULL;
@@ -139,7 +140,12 @@ typedef enum gmpu_param {
     /* Noise floor for ε: fit estimates the sampling noise σ̂ and works to
      * max(GMPU_PARAM_ERROR, NOISE_SCALE × σ̂), since fitting below the noise only fits the
      * noise. Default 2; 0 turns the floor off. Range [0, 20]. Discards a previous fit. */
-    GMPU_PARAM_NOISE_SCALE = 11
+    GMPU_PARAM_NOISE_SCALE = 11,
+    /* Memory budget in bytes: fit and polygonize first estimate their peak memory (from the
+     * point count, the cell cap and the grid resolution) and fail with
+     * GMPU_ERROR_LIMIT_EXCEEDED, naming the estimate and the budget, instead of starting
+     * work the machine cannot hold. Default: half the physical memory. Range 1e6..1e15. */
+    GMPU_PARAM_MAX_MEMORY = 12
 } gmpu_param;
 
 typedef enum gmpu_stage {
@@ -166,7 +172,10 @@ typedef enum gmpu_stat {
     GMPU_STAT_RESOLUTION = 13,        /* grid resolution the last polygonize used */
     GMPU_STAT_BBOX_DIAGONAL = 14,     /* diagonal of the points' bounding box */
     GMPU_STAT_NOISE = 15,             /* estimated noise σ̂, as a fraction of the diagonal */
-    GMPU_STAT_EFFECTIVE_ERROR = 16    /* the ε fit worked to, as a fraction of the diagonal */
+    GMPU_STAT_EFFECTIVE_ERROR = 16,   /* the ε fit worked to, as a fraction of the diagonal */
+    GMPU_STAT_OUTLIERS = 17           /* input points set aside as outliers by set_points: far
+                                       * from every other point compared with the cloud's
+                                       * spacing; they set no scale and join no fit */
 } gmpu_stat;
 
 /* Progress and cancellation. Called on the thread that called fit / orient / polygonize,
