@@ -17,6 +17,7 @@
 #include "core/release_memory.hpp"
 #include "fit/build_octree.hpp"
 #include "fit/noise_estimate.hpp"
+#include "geometry/outliers.hpp"
 #include "geometry/point_set.hpp"
 #include "implicit/mpu_function.hpp"
 #include "implicit/surface_field.hpp"
@@ -32,7 +33,10 @@ struct gmpu_surface {
     enum class Stage { empty, points, fitted, oriented };
     Stage stage = Stage::empty;
     gmpu::Params params;
-    gmpu::PointSet points;
+    gmpu::PointSet points;             // the input points less the outliers
+    size_t input_count = 0;            // points given to set_points, outliers included
+    std::vector<uint32_t> outliers;        // input indices set aside, increasing
+    std::vector<uint32_t> outlier_nearest; // per outlier: the nearest kept point
     std::vector<float> input_normals;  // unit, 3 per point; empty when none were given
     gmpu::Octree tree;
     gmpu::PointMeasures measures;      // oriented normals, areas, trust radii per point
@@ -218,9 +222,53 @@ gmpu_status set_points(gmpu_surface *s, const T *xyz, size_t count, size_t strid
         require_arg(s, "surface");
         s->require_idle("gmpu_surface_set_points");
         check_array(xyz, count, stride, 3 * sizeof(T), "xyz");
-        gmpu::PointSet points = gmpu::PointSet::from_array(xyz, count, stride, size_t(s->params.min_points));
+        const size_t min_points = size_t(s->params.min_points);
+        gmpu::OutlierScan scan = gmpu::find_outliers(xyz, count, stride);
+        // The points' own spacing, not their bounding box, is the scale of the detail: one
+        // octree in float coordinates resolves about a millionth of the extent.
+        if (scan.spacing > 0.0 && scan.spacing < 1e-6 * scan.extent)
+            throw Error(GMPU_ERROR_INVALID_INPUT,
+                        "the points are spaced " + number(scan.spacing) + " apart over an extent of " +
+                            number(scan.extent) +
+                            ": clusters this far apart cannot share one surface's scale; reconstruct each "
+                            "cluster on its own surface");
+        gmpu::PointSet points;
+        std::vector<uint32_t> nearest;
+        if (scan.outliers.empty()) {
+            points = gmpu::PointSet::from_array(xyz, count, stride, min_points);
+        } else {
+            // The scale comes from the points that are not outliers: the outliers join no fit.
+            const size_t step = stride ? stride : 3 * sizeof(T);
+            const auto *bytes = reinterpret_cast<const unsigned char *>(xyz);
+            std::vector<T> kept;
+            kept.reserve(3 * (count - scan.outliers.size()));
+            size_t next = 0;
+            for (size_t i = 0; i < count; ++i) {
+                if (next < scan.outliers.size() && scan.outliers[next] == i) {
+                    ++next;
+                    continue;
+                }
+                T v[3];
+                std::memcpy(v, bytes + i * step, sizeof v);
+                kept.insert(kept.end(), v, v + 3);
+            }
+            points = gmpu::PointSet::from_array(kept.data(), kept.size() / 3, 0, min_points);
+            points.set_outlier_count(scan.outliers.size());
+            std::vector<uint32_t> idx;
+            std::vector<float> d2;
+            for (uint32_t o : scan.outliers) {
+                T v[3];
+                std::memcpy(v, bytes + o * step, sizeof v);
+                const Eigen::Vector3d q = points.normalisation().to_unit({double(v[0]), double(v[1]), double(v[2])});
+                points.nearest(q.cwiseMax(-1e15).cwiseMin(1e15), 1, idx, d2);
+                nearest.push_back(idx.empty() ? 0 : idx[0]);
+            }
+        }
         s->discard_fit();
         s->points = std::move(points);
+        s->input_count = count;
+        s->outliers = std::move(scan.outliers);
+        s->outlier_nearest = std::move(nearest);
         s->input_normals.clear();
         s->stage = gmpu_surface::Stage::points;
     });
@@ -233,11 +281,13 @@ gmpu_status set_normals(gmpu_surface *s, const T *nxyz, size_t count, size_t str
         s->require_idle("gmpu_surface_set_normals");
         s->require(gmpu_surface::Stage::points, "gmpu_surface_set_normals", "gmpu_surface_set_points");
         check_array(nxyz, count, stride, 3 * sizeof(T), "nxyz");
-        if (count != s->points.size())
+        if (count != s->input_count)
             throw Error(GMPU_ERROR_INVALID_INPUT, std::to_string(count) + " normals given for " +
-                                                      std::to_string(s->points.size()) + " points");
+                                                      std::to_string(s->input_count) + " points");
         if (stride == 0) stride = 3 * sizeof(T);
-        std::vector<float> unit(3 * count);
+        std::vector<float> unit;
+        unit.reserve(3 * s->points.size());
+        size_t next_outlier = 0;
         const auto *bytes = reinterpret_cast<const unsigned char *>(nxyz);
         for (size_t i = 0; i < count; ++i) {
             T v[3];
@@ -252,7 +302,11 @@ gmpu_status set_normals(gmpu_surface *s, const T *nxyz, size_t count, size_t str
                 throw Error(GMPU_ERROR_INVALID_INPUT, "normal " + std::to_string(i) + " is zero");
             n /= largest;
             n /= n.norm();
-            for (int d = 0; d < 3; ++d) unit[3 * i + d] = float(n[d]);
+            if (next_outlier < s->outliers.size() && s->outliers[next_outlier] == i) {
+                ++next_outlier;  // validated like the others, but no fit is near it
+                continue;
+            }
+            for (int d = 0; d < 3; ++d) unit.push_back(float(n[d]));
         }
         s->input_normals.swap(unit);
         if (s->stage > gmpu_surface::Stage::fitted) s->stage = gmpu_surface::Stage::fitted;
@@ -318,7 +372,7 @@ GMPU_API gmpu_status gmpu_surface_get_stat(const gmpu_surface *s, gmpu_stat key,
             return n;
         };
         switch (key) {
-            case GMPU_STAT_POINTS: *value = double(s->points.size()); break;
+            case GMPU_STAT_POINTS: *value = double(s->input_count); break;
             case GMPU_STAT_CELLS: *value = double(cells.size()); break;
             case GMPU_STAT_LEAVES: *value = leaves_where([](const gmpu::Cell &) { return true; }); break;
             case GMPU_STAT_DEPTH: {
@@ -379,7 +433,7 @@ GMPU_API gmpu_status gmpu_surface_set_normals_f32(gmpu_surface *s, const float *
     return set_normals(s, n, count, stride);
 }
 
-GMPU_API size_t gmpu_surface_point_count(const gmpu_surface *s) { return s ? s->points.size() : 0; }
+GMPU_API size_t gmpu_surface_point_count(const gmpu_surface *s) { return s ? s->input_count : 0; }
 
 GMPU_API gmpu_status gmpu_surface_fit(gmpu_surface *s) {
     return run_stage(s, GMPU_STAGE_FIT, "gmpu_surface_fit", [&] {
@@ -469,10 +523,19 @@ GMPU_API gmpu_status gmpu_surface_copy_normals(const gmpu_surface *s, double *ou
         require_arg(out, "out");
         s->require_idle("gmpu_surface_copy_normals");
         s->require(gmpu_surface::Stage::oriented, "gmpu_surface_copy_normals", "gmpu_surface_orient");
-        if (count != s->points.size())
+        if (count != s->input_count)
             throw Error(GMPU_ERROR_INVALID_ARGUMENT, "count " + std::to_string(count) + " differs from the " +
-                                                         std::to_string(s->points.size()) + " points");
-        for (size_t i = 0; i < 3 * count; ++i) out[i] = double(s->measures.normals[i]);
+                                                         std::to_string(s->input_count) + " points");
+        // An outlier takes the normal of the kept point nearest to it.
+        size_t next_outlier = 0, kept = 0;
+        for (size_t i = 0; i < count; ++i) {
+            size_t from;
+            if (next_outlier < s->outliers.size() && s->outliers[next_outlier] == i)
+                from = s->outlier_nearest[next_outlier++];
+            else
+                from = kept++;
+            for (int d = 0; d < 3; ++d) out[3 * i + d] = double(s->measures.normals[3 * from + d]);
+        }
     });
 }
 
@@ -490,6 +553,11 @@ GMPU_API gmpu_status gmpu_surface_polygonize(gmpu_surface *s, gmpu_mesh **out) {
         auto mesh = std::make_unique<gmpu_mesh>();
         mesh->mesh = gmpu::polygonize(mpu, s->winding, s->points, s->measures, resolution, s->params, progress);
         progress.throw_if_cancelled();  // a cancel on the final report counts too
+        if (mesh->mesh.triangle_count() == 0)
+            throw Error(GMPU_ERROR_DEGENERATE_INPUT,
+                        "polygonize found no closed surface at resolution " + std::to_string(resolution) +
+                            " (no piece of the zero set is near enough input points): the points may be "
+                            "too few or too sparse for a solid, or the grid too coarse for them");
         s->last_resolution = resolution;
         s->seconds[GMPU_STAGE_POLYGONIZE] = since(t0);
         *out = mesh.release();

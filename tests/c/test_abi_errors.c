@@ -233,6 +233,8 @@ static void test_tiny_clouds(void **state) {
         if (st == GMPU_OK) {
             const char *problem = robust_mesh_problem(m);
             if (problem) fail_msg("%zu points: %s", sizes[k], problem);
+            /* An empty mesh is no success: it must be an error with a message. */
+            if (gmpu_mesh_triangle_count(m) == 0) fail_msg("%zu points: an empty mesh and GMPU_OK", sizes[k]);
         } else {
             assert_null(m);
             assert_true(strlen(gmpu_last_error()) > strlen(gmpu_status_name(st)) + 4);
@@ -739,6 +741,66 @@ static void test_reentrant_calls_refused(void **state) {
     assert_int_equal(GMPU_ERROR_BUSY, 12);
 }
 
+/* A few points far from the rest (a scanner's stray returns, a wrong line in a file) must not
+ * set the scale: with two of them at ±100 to ±1e6 sphere radii, the sphere is still meshed
+ * as without them (they used to leave it smaller than one grid cube: an empty mesh and
+ * GMPU_OK, or a blob around the outliers, or "collinear"). They are counted in
+ * GMPU_STAT_OUTLIERS, still count as input points, and get the nearest point's normal. */
+static void test_outliers_set_aside(void **state) {
+    (void)state;
+    const size_t n = N_GOOD + 2;
+    double *xyz = malloc(3 * n * sizeof *xyz), *normals = malloc(3 * n * sizeof *normals);
+    memcpy(xyz, g_good, 3 * N_GOOD * sizeof *xyz);
+    gmpu_surface *clean = new_surface();
+    gmpu_mesh *reference = robust_reconstruct(clean, g_good, N_GOOD);
+    double clean_outliers = -1, clean_diag = 0;
+    assert_ok(gmpu_surface_get_stat(clean, GMPU_STAT_OUTLIERS, &clean_outliers));
+    assert_ok(gmpu_surface_get_stat(clean, GMPU_STAT_BBOX_DIAGONAL, &clean_diag));
+    assert_true(clean_outliers == 0);
+    const double offsets[] = {100, 1000, 1e4, 1e6};
+    for (size_t k = 0; k < sizeof offsets / sizeof *offsets; ++k) {
+        for (int d = 0; d < 3; ++d) {
+            xyz[3 * N_GOOD + d] = kCentre[d] + offsets[k];
+            xyz[3 * N_GOOD + 3 + d] = kCentre[d] - offsets[k] * (d == 1 ? 0.5 : 1.0);
+        }
+        gmpu_surface *s = new_surface();
+        gmpu_mesh *m = robust_reconstruct(s, xyz, n);
+        double outliers = 0, points = 0, diag = 0;
+        assert_ok(gmpu_surface_get_stat(s, GMPU_STAT_OUTLIERS, &outliers));
+        assert_ok(gmpu_surface_get_stat(s, GMPU_STAT_POINTS, &points));
+        assert_ok(gmpu_surface_get_stat(s, GMPU_STAT_BBOX_DIAGONAL, &diag));
+        if (outliers != 2) fail_msg("outliers at %g: %g found", offsets[k], outliers);
+        assert_true(points == (double)n && gmpu_surface_point_count(s) == n);
+        assert_true(diag == clean_diag); /* the scale is the sphere's */
+        /* The same mesh as without the outliers. */
+        assert_int_equal(gmpu_mesh_triangle_count(m), gmpu_mesh_triangle_count(reference));
+        assert_memory_equal(gmpu_mesh_vertices(m), gmpu_mesh_vertices(reference),
+                            3 * gmpu_mesh_vertex_count(m) * sizeof(double));
+        /* Normals for every input point, the outliers included (unit length). */
+        assert_ok(gmpu_surface_copy_normals(s, normals, n));
+        for (size_t i = N_GOOD; i < n; ++i) {
+            const double *v = normals + 3 * i;
+            assert_true(fabs(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] - 1) < 1e-6);
+        }
+        /* Input normals count the outliers too. */
+        assert_ok(gmpu_surface_set_normals_f64(s, normals, n, 0));
+        check_failure(gmpu_surface_set_normals_f64(s, normals, N_GOOD, 0), GMPU_ERROR_INVALID_INPUT, "2002 points");
+        gmpu_mesh_destroy(m);
+        gmpu_surface_destroy(s);
+    }
+    gmpu_mesh_destroy(reference);
+    gmpu_surface_destroy(clean);
+
+    /* Two clusters a million sizes apart: not "collinear", but a message saying what it is. */
+    for (size_t i = 0; i < N_GOOD; ++i)
+        for (int d = 0; d < 3; ++d) xyz[3 * i + d] = g_good[3 * i + d] + (i % 2 ? 1e6 : 0.0);
+    gmpu_surface *s = new_surface();
+    check_failure(gmpu_surface_set_points_f64(s, xyz, N_GOOD, 0), GMPU_ERROR_INVALID_INPUT, "clusters");
+    free(xyz);
+    free(normals);
+    check_usable_and_destroy(s);
+}
+
 /* Counts whose byte sizes overflow size_t are rejected before any read. */
 static void test_overflowing_counts(void **state) {
     (void)state;
@@ -805,6 +867,7 @@ int main(void) {
         cmocka_unit_test(test_reentrant_calls_refused),
         cmocka_unit_test(test_overflowing_counts),
         cmocka_unit_test(test_normals_of_any_length),
+        cmocka_unit_test(test_outliers_set_aside),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
