@@ -2,7 +2,8 @@
  * cleanly with GMPU_ERROR_LIMIT_EXCEEDED exactly past the cap (the cap itself is allowed),
  * quickly, without keeping a partial result, and leave the handle usable;
  * GMPU_PARAM_MAX_DEPTH caps GMPU_STAT_DEPTH; a process limit that refuses worker threads
- * costs parallelism, never the process or the result. */
+ * costs parallelism, never the process or the result; GMPU_PARAM_MAX_MEMORY refuses what
+ * would not fit the budget. */
 #define _GNU_SOURCE
 #include <setjmp.h>
 #include <stdarg.h>
@@ -277,6 +278,76 @@ static void test_thread_creation_refused(void **state) {
     gmpu_mesh_destroy(reference);
 }
 
+/* GMPU_PARAM_MAX_MEMORY: half the physical memory by default; a stage whose estimated peak
+ * exceeds it fails with LIMIT_EXCEEDED naming the estimate and the budget, before it
+ * allocates what it cannot hold (a resolution of 4096 fails at once, instead of growing
+ * until the system kills the process), and keeps the surface usable. Whatever the budget, a
+ * stage either fails so or gives the mesh of an unlimited budget. */
+static void test_max_memory(void **state) {
+    (void)state;
+    gmpu_surface *s = surface_with_points();
+    double v = 0;
+    assert_ok(gmpu_surface_get_param(s, GMPU_PARAM_MAX_MEMORY, &v));
+    const double half = 0.5 * (double)sysconf(_SC_PHYS_PAGES) * (double)sysconf(_SC_PAGESIZE);
+    if (fabs(v - half) > 1) fail_msg("default GMPU_PARAM_MAX_MEMORY %g, half the physical memory %g", v, half);
+
+    gmpu_status status;
+    gmpu_mesh *reference = bumpy_mesh(0, &status);
+    assert_ok(status);
+
+    /* A budget too small for the points themselves: fit refuses at once. */
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_MAX_MEMORY, 1e6));
+    check_failure(gmpu_surface_fit(s), GMPU_ERROR_LIMIT_EXCEEDED, "GMPU_PARAM_MAX_MEMORY = 1e+06 bytes");
+    assert_non_null(strstr(gmpu_last_error(), "fit ("));
+
+    /* Fitted and oriented with room to spare, then a huge grid on a small budget: refused
+     * before the grid is allocated, in a fraction of a normal polygonize's time. */
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_MAX_MEMORY, v));
+    assert_ok(gmpu_surface_fit(s));
+    assert_ok(gmpu_surface_orient(s));
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_MAX_MEMORY, 2e8));
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_RESOLUTION, 4096));
+    gmpu_mesh *m = (gmpu_mesh *)&m;
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t0);
+    check_failure(gmpu_surface_polygonize(s, &m), GMPU_ERROR_LIMIT_EXCEEDED, "resolution 4096");
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t1);
+    assert_null(m);
+    assert_non_null(strstr(gmpu_last_error(), "GMPU_PARAM_MAX_MEMORY = 2e+08 bytes"));
+    const double cpu = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+    if (!robust_quick() && cpu > 0.5) fail_msg("the refused polygonize took %.3f s of CPU", cpu);
+
+    /* Budgets from tiny to ample: each stage fails cleanly or gives the same mesh. Both checks
+     * are met on the way: the one before the stage allocates, and the one as it goes. */
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_RESOLUTION, 40));
+    int refused = 0, fitted_ok = 0;
+    for (double budget = 1e6; budget <= 1e9; budget *= 1.5) {
+        assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_MAX_MEMORY, floor(budget)));
+        m = NULL;
+        status = gmpu_surface_fit(s);
+        if (status == GMPU_OK) fitted_ok = 1, status = gmpu_surface_orient(s);
+        if (status == GMPU_OK) status = gmpu_surface_polygonize(s, &m);
+        if (status == GMPU_OK) {
+            if (!same_mesh(m, reference)) fail_msg("budget %g: another mesh", budget);
+            gmpu_mesh_destroy(m);
+            break;
+        }
+        if (status != GMPU_ERROR_LIMIT_EXCEEDED || !strstr(gmpu_last_error(), "GMPU_PARAM_MAX_MEMORY"))
+            fail_msg("budget %g: %s", budget, gmpu_last_error());
+        assert_null(m);
+        ++refused;
+    }
+    assert_true(refused > 0 && fitted_ok);
+    /* Back to the default: the same handle meshes. */
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_MAX_MEMORY, v));
+    m = NULL;
+    assert_ok(gmpu_surface_polygonize(s, &m));
+    assert_true(same_mesh(m, reference));
+    gmpu_mesh_destroy(m);
+    gmpu_mesh_destroy(reference);
+    gmpu_surface_destroy(s);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_max_cells),
@@ -284,6 +355,7 @@ int main(void) {
         cmocka_unit_test(test_max_depth),
         cmocka_unit_test(test_memory_returned),
         cmocka_unit_test(test_thread_creation_refused),
+        cmocka_unit_test(test_max_memory),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
