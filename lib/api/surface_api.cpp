@@ -216,6 +216,13 @@ void check_array(const void *data, size_t count, size_t stride, size_t element, 
         throw Error(GMPU_ERROR_INVALID_ARGUMENT, std::string(what) + ": too many points");
 }
 
+Error clusters(const gmpu::OutlierScan &scan) {
+    return Error(GMPU_ERROR_INVALID_INPUT, "the points are spaced " + number(scan.spacing) +
+                                               " apart over an extent of " + number(scan.extent) +
+                                               ": clusters this far apart cannot share one surface's scale; "
+                                               "reconstruct each cluster on its own surface");
+}
+
 template <class T>
 gmpu_status set_points(gmpu_surface *s, const T *xyz, size_t count, size_t stride) {
     return guarded(s ? &s->last_error : nullptr, [&] {
@@ -226,16 +233,19 @@ gmpu_status set_points(gmpu_surface *s, const T *xyz, size_t count, size_t strid
         gmpu::OutlierScan scan = gmpu::find_outliers(xyz, count, stride);
         // The points' own spacing, not their bounding box, is the scale of the detail: one
         // octree in float coordinates resolves about a millionth of the extent.
-        if (scan.spacing > 0.0 && scan.spacing < 1e-6 * scan.extent)
-            throw Error(GMPU_ERROR_INVALID_INPUT,
-                        "the points are spaced " + number(scan.spacing) + " apart over an extent of " +
-                            number(scan.extent) +
-                            ": clusters this far apart cannot share one surface's scale; reconstruct each "
-                            "cluster on its own surface");
+        if (scan.spacing > 0.0 && scan.spacing < 1e-6 * scan.extent) throw clusters(scan);
         gmpu::PointSet points;
         std::vector<uint32_t> nearest;
         if (scan.outliers.empty()) {
-            points = gmpu::PointSet::from_array(xyz, count, stride, min_points);
+            try {
+                points = gmpu::PointSet::from_array(xyz, count, stride, min_points);
+            } catch (const Error &e) {
+                // Far-apart clusters look collinear or coplanar from afar: say what they are.
+                if (e.status() != GMPU_ERROR_DEGENERATE_INPUT) throw;
+                const gmpu::OutlierScan full = gmpu::find_outliers(xyz, count, stride, false);
+                if (full.spacing > 0.0 && full.spacing < 1e-6 * full.extent) throw clusters(full);
+                throw;
+            }
         } else {
             // The scale comes from the points that are not outliers: the outliers join no fit.
             const size_t step = stride ? stride : 3 * sizeof(T);

@@ -36,26 +36,63 @@ struct EnoughWithin {
     double worstDist() const { return radius_sq; }
 };
 
+// Whether, on some axis, the bounding box is over kBulkFactor times as wide as the range
+// between the kBulkQuantile and 1 - kBulkQuantile quantiles of a sample: outliers that
+// would set the scale widen the box so. Sets `finite` to whether every coordinate is within
+// ±1e300.
+bool box_wider_than_bulk(const unsigned char *bytes, size_t count, size_t stride, bool &finite,
+                         double (*read)(const unsigned char *, int)) {
+    constexpr size_t kSample = 1 << 14;
+    constexpr double kBulkQuantile = 0.01, kBulkFactor = 2.0;
+    const size_t step = std::max<size_t>(1, count / kSample);
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    std::vector<double> sample[3];
+    finite = true;
+    for (size_t i = 0; i < count; ++i)
+        for (int d = 0; d < 3; ++d) {
+            const double c = read(bytes + i * stride, d);
+            if (!(std::fabs(c) <= 1e300)) {
+                finite = false;
+                return false;
+            }
+            lo[d] = std::min(lo[d], c);
+            hi[d] = std::max(hi[d], c);
+            if (i % step == 0) sample[d].push_back(c);
+        }
+    for (int d = 0; d < 3; ++d) {
+        std::vector<double> &v = sample[d];
+        const size_t a = size_t(kBulkQuantile * double(v.size())), b = v.size() - 1 - a;
+        std::nth_element(v.begin(), v.begin() + long(a), v.end());
+        const double qa = v[a];
+        std::nth_element(v.begin(), v.begin() + long(b), v.end());
+        if (hi[d] - lo[d] > kBulkFactor * (v[b] - qa)) return true;
+    }
+    return false;
+}
+
+template <class T>
+double read_coordinate(const unsigned char *point, int d) {
+    T v;
+    std::memcpy(&v, point + size_t(d) * sizeof(T), sizeof v);
+    return double(v);
+}
+
 }  // namespace
 
 template <class T>
-OutlierScan find_outliers(const T *xyz, size_t count, size_t stride) {
+OutlierScan find_outliers(const T *xyz, size_t count, size_t stride, bool only_if_box_is_wide) {
     OutlierScan scan;
     if (stride == 0) stride = 3 * sizeof(T);
     const size_t k = kOutlierNeighbours;
     if (count <= 2 * k) return scan;  // too few points to call any of them far from the rest
+    const auto *bytes = reinterpret_cast<const unsigned char *>(xyz);
+    bool finite = true;
+    const bool wide = box_wider_than_bulk(bytes, count, stride, finite, read_coordinate<T>);
+    if (!finite || (only_if_box_is_wide && !wide)) return scan;
     DoubleCloud cloud;
     cloud.xyz.resize(3 * count);
-    const auto *bytes = reinterpret_cast<const unsigned char *>(xyz);
-    for (size_t i = 0; i < count; ++i) {
-        T v[3];
-        std::memcpy(v, bytes + i * stride, sizeof v);
-        for (int d = 0; d < 3; ++d) {
-            const double c = double(v[d]);
-            if (!(std::fabs(c) <= 1e300)) return scan;
-            cloud.xyz[3 * i + d] = c;
-        }
-    }
+    for (size_t i = 0; i < count; ++i)
+        for (int d = 0; d < 3; ++d) cloud.xyz[3 * i + d] = read_coordinate<T>(bytes + i * stride, d);
     DoubleTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
     tree.buildIndex();
 
@@ -97,7 +134,7 @@ OutlierScan find_outliers(const T *xyz, size_t count, size_t stride) {
     return scan;
 }
 
-template OutlierScan find_outliers<double>(const double *, size_t, size_t);
-template OutlierScan find_outliers<float>(const float *, size_t, size_t);
+template OutlierScan find_outliers<double>(const double *, size_t, size_t, bool);
+template OutlierScan find_outliers<float>(const float *, size_t, size_t, bool);
 
 }  // namespace gmpu

@@ -25,7 +25,11 @@ constexpr double kOutlierFar = 20.0;
 
 // `xyz`: count points of type T (double or float), `stride` bytes apart. Finds nothing (and
 // leaves the errors to PointSet) when a coordinate is not finite or beyond ±1e300.
+// With only_if_box_is_wide, the neighbour scan (a kd-tree over every point) runs only when
+// the bounding box is over twice as wide as the bulk of the points (their 1 %–99 % range on
+// some axis): outliers that do not widen the box so do not set the scale either, and most
+// clouds are spared the scan's cost.
 template <class T>
-OutlierScan find_outliers(const T *xyz, size_t count, size_t stride);
+OutlierScan find_outliers(const T *xyz, size_t count, size_t stride, bool only_if_box_is_wide = true);
 
 }  // namespace gmpu

@@ -160,7 +160,7 @@ gmpu_status status_of(Fn &&fn, std::string *message = nullptr) {
 // clusters, a sparse but evenly sampled region, and clouds too small to judge are not.
 void outliers_are_far_from_everything(void **) {
     std::vector<double> xyz = flat(sphere_points(2000, 1, 0, 1));
-    OutlierScan none = find_outliers(xyz.data(), 2000, 0);
+    OutlierScan none = find_outliers(xyz.data(), 2000, 0, false);
     assert_true(none.outliers.empty());
     assert_true(none.spacing > 0.0 && std::fabs(none.extent - 2.0) < 0.01);
     // Every 10th point of a second sphere 10 radii away: ten times sparser, still no outlier.
@@ -168,7 +168,7 @@ void outliers_are_far_from_everything(void **) {
     for (size_t i = 0; i < sparse.size(); i += 3) sparse[i] += 10.0;
     std::vector<double> both = xyz;
     both.insert(both.end(), sparse.begin(), sparse.end());
-    assert_true(find_outliers(both.data(), both.size() / 3, 0).outliers.empty());
+    assert_true(find_outliers(both.data(), both.size() / 3, 0, false).outliers.empty());
     for (double far : {30.0, 1e3, 1e8}) {
         std::vector<double> with = xyz;
         with.insert(with.end(), {far, 0.0, 0.0, -far, far, 0.5});                  // two strays
@@ -185,6 +185,8 @@ void outliers_are_far_from_everything(void **) {
     for (size_t i = 0; i < 2000; ++i) rec.insert(rec.end(), {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2], NAN});
     rec.insert(rec.end(), {1e4, 0, 0, NAN});
     assert_int_equal(find_outliers(rec.data(), 2001, 4 * sizeof(double)).outliers.size(), 1);
+    // Without a box wider than the bulk of the points, the scan is skipped (spacing 0).
+    assert_true(find_outliers(xyz.data(), 2000, 0).spacing == 0.0);
     std::vector<double> few = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1e6, 1e6, 1e6};
     assert_true(find_outliers(few.data(), 5, 0).outliers.empty());
 }
