@@ -223,6 +223,54 @@ Error clusters(const gmpu::OutlierScan &scan) {
                                                "reconstruct each cluster on its own surface");
 }
 
+// The points as given; when they look collinear or coplanar, says so unless they are
+// far-apart clusters (which look so from afar).
+template <class T>
+gmpu::PointSet points_or_clusters(const T *xyz, size_t count, size_t stride, size_t min_points) {
+    try {
+        return gmpu::PointSet::from_array(xyz, count, stride, min_points);
+    } catch (const Error &e) {
+        if (e.status() != GMPU_ERROR_DEGENERATE_INPUT) throw;
+        const gmpu::OutlierScan full = gmpu::find_outliers(xyz, count, stride, false);
+        if (full.spacing > 0.0 && full.spacing < 1e-6 * full.extent) throw clusters(full);
+        throw;
+    }
+}
+
+// The points less the outliers: the scale comes from them, and only they join the fits.
+// nearest[k]: the kept point nearest to outlier k (its normal stands in for the outlier's).
+template <class T>
+gmpu::PointSet kept_points(const T *xyz, size_t count, size_t stride, size_t min_points,
+                           const std::vector<uint32_t> &outliers, std::vector<uint32_t> &nearest) {
+    const size_t step = stride ? stride : 3 * sizeof(T);
+    const auto *bytes = reinterpret_cast<const unsigned char *>(xyz);
+    auto read = [&](size_t i, T v[3]) { std::memcpy(v, bytes + i * step, 3 * sizeof(T)); };
+    std::vector<T> kept;
+    kept.reserve(3 * (count - outliers.size()));
+    size_t next = 0;
+    for (size_t i = 0; i < count; ++i) {
+        if (next < outliers.size() && outliers[next] == i) {
+            ++next;
+            continue;
+        }
+        T v[3];
+        read(i, v);
+        kept.insert(kept.end(), v, v + 3);
+    }
+    gmpu::PointSet points = gmpu::PointSet::from_array(kept.data(), kept.size() / 3, 0, min_points);
+    points.set_outlier_count(outliers.size());
+    std::vector<uint32_t> idx;
+    std::vector<float> d2;
+    for (uint32_t o : outliers) {
+        T v[3];
+        read(o, v);
+        const Eigen::Vector3d q = points.normalisation().to_unit({double(v[0]), double(v[1]), double(v[2])});
+        points.nearest(q.cwiseMax(-1e15).cwiseMin(1e15), 1, idx, d2);
+        nearest.push_back(idx.empty() ? 0 : idx[0]);
+    }
+    return points;
+}
+
 template <class T>
 gmpu_status set_points(gmpu_surface *s, const T *xyz, size_t count, size_t stride) {
     return guarded(s ? &s->last_error : nullptr, [&] {
@@ -234,46 +282,9 @@ gmpu_status set_points(gmpu_surface *s, const T *xyz, size_t count, size_t strid
         // The points' own spacing, not their bounding box, is the scale of the detail: one
         // octree in float coordinates resolves about a millionth of the extent.
         if (scan.spacing > 0.0 && scan.spacing < 1e-6 * scan.extent) throw clusters(scan);
-        gmpu::PointSet points;
         std::vector<uint32_t> nearest;
-        if (scan.outliers.empty()) {
-            try {
-                points = gmpu::PointSet::from_array(xyz, count, stride, min_points);
-            } catch (const Error &e) {
-                // Far-apart clusters look collinear or coplanar from afar: say what they are.
-                if (e.status() != GMPU_ERROR_DEGENERATE_INPUT) throw;
-                const gmpu::OutlierScan full = gmpu::find_outliers(xyz, count, stride, false);
-                if (full.spacing > 0.0 && full.spacing < 1e-6 * full.extent) throw clusters(full);
-                throw;
-            }
-        } else {
-            // The scale comes from the points that are not outliers: the outliers join no fit.
-            const size_t step = stride ? stride : 3 * sizeof(T);
-            const auto *bytes = reinterpret_cast<const unsigned char *>(xyz);
-            std::vector<T> kept;
-            kept.reserve(3 * (count - scan.outliers.size()));
-            size_t next = 0;
-            for (size_t i = 0; i < count; ++i) {
-                if (next < scan.outliers.size() && scan.outliers[next] == i) {
-                    ++next;
-                    continue;
-                }
-                T v[3];
-                std::memcpy(v, bytes + i * step, sizeof v);
-                kept.insert(kept.end(), v, v + 3);
-            }
-            points = gmpu::PointSet::from_array(kept.data(), kept.size() / 3, 0, min_points);
-            points.set_outlier_count(scan.outliers.size());
-            std::vector<uint32_t> idx;
-            std::vector<float> d2;
-            for (uint32_t o : scan.outliers) {
-                T v[3];
-                std::memcpy(v, bytes + o * step, sizeof v);
-                const Eigen::Vector3d q = points.normalisation().to_unit({double(v[0]), double(v[1]), double(v[2])});
-                points.nearest(q.cwiseMax(-1e15).cwiseMin(1e15), 1, idx, d2);
-                nearest.push_back(idx.empty() ? 0 : idx[0]);
-            }
-        }
+        gmpu::PointSet points = scan.outliers.empty() ? points_or_clusters(xyz, count, stride, min_points)
+                                                      : kept_points(xyz, count, stride, min_points, scan.outliers, nearest);
         s->discard_fit();
         s->points = std::move(points);
         s->input_count = count;
