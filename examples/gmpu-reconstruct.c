@@ -295,6 +295,9 @@ int main(int argc, char **argv) {
         rc = fail("bad input points");
         goto done;
     }
+    double outliers = 0;
+    if (!o.quiet && gmpu_surface_get_stat(surface, GMPU_STAT_OUTLIERS, &outliers) == GMPU_OK && outliers > 0)
+        fprintf(stderr, "gmpu: %.0f outlier points (far from all others) set aside\n", outliers);
     if (o.use_normals) {
         if (!gmpu_points_normals(cloud)) {
             fprintf(stderr, "gmpu-reconstruct: --use-normals given but %s has no normals\n", o.input);

@@ -26,7 +26,8 @@ export type StatusName =
     | 'GMPU_ERROR_IO'
     | 'GMPU_ERROR_PARSE'
     | 'GMPU_ERROR_UNSUPPORTED'
-    | 'GMPU_ERROR_INTERNAL';
+    | 'GMPU_ERROR_INTERNAL'
+    | 'GMPU_ERROR_BUSY';
 export declare const Status: Readonly<Record<StatusName, number>>;
 
 /**
@@ -84,6 +85,8 @@ export interface Parameters {
     maxTriangles?: number;
     /** Noise floor for ε, in units of the estimated noise; 0 = off. Default 1.75, [0, 20]. */
     noiseScale?: number;
+    /** Memory budget in bytes: fit and polygonize fail (GMPU_ERROR_LIMIT_EXCEEDED) when their estimated peak exceeds it. Default half the physical memory; 1e6..1e15. */
+    maxMemory?: number;
 }
 export type ParameterName = keyof Parameters;
 export declare const parameterNames: readonly ParameterName[];
@@ -130,6 +133,8 @@ export interface Statistics {
     bboxDiagonal: number;
     noise: number;
     effectiveError: number;
+    /** Input points set aside as outliers by setPoints (far from every other point). */
+    outliers: number;
 }
 export type StatisticName = keyof Statistics;
 export declare const statisticNames: readonly StatisticName[];

@@ -20,6 +20,7 @@ export const Status = Object.freeze({
     GMPU_ERROR_PARSE: 9,
     GMPU_ERROR_UNSUPPORTED: 10,
     GMPU_ERROR_INTERNAL: 11,
+    GMPU_ERROR_BUSY: 12,
 });
 const statusNames = Object.fromEntries(Object.entries(Status).map(([k, v]) => [v, k]));
 
@@ -78,6 +79,7 @@ const PARAMS = Object.freeze({
     maxCells: 9,
     maxTriangles: 10,
     noiseScale: 11,
+    maxMemory: 12,
 });
 
 const STATS = Object.freeze({
@@ -97,6 +99,7 @@ const STATS = Object.freeze({
     bboxDiagonal: 14,
     noise: 15,
     effectiveError: 16,
+    outliers: 17,
 });
 
 const STAGES = Object.freeze({ 1: 'fit', 2: 'orient', 3: 'polygonize' });

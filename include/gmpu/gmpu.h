@@ -50,9 +50,9 @@
  * library at run time. GMPU_ABI_VERSION changes only when the ABI breaks (it is the
  * SONAME's number: libgmpu.so.1). */
 #define GMPU_VERSION_MAJOR 0
-#define GMPU_VERSION_MINOR 1
+#define GMPU_VERSION_MINOR 2
 #define GMPU_VERSION_PATCH 0
-#define GMPU_VERSION_NUMBER 100 /* MAJOR*10000 + MINOR*100 + PATCH */
+#define GMPU_VERSION_NUMBER 200 /* MAJOR*10000 + MINOR*100 + PATCH */
 #define GMPU_ABI_VERSION 1
 
 #ifdef __cplusplus
@@ -77,12 +77,13 @@ typedef enum gmpu_status {
     GMPU_ERROR_DEGENERATE_INPUT = 3, /* identical, collinear or coplanar points: no solid */
     GMPU_ERROR_WRONG_ORDER = 4,      /* a stage called before the one it needs */
     GMPU_ERROR_OUT_OF_MEMORY = 5,
-    GMPU_ERROR_LIMIT_EXCEEDED = 6,   /* GMPU_PARAM_MAX_CELLS or the triangle cap was hit */
+    GMPU_ERROR_LIMIT_EXCEEDED = 6,   /* a cap (cells, triangles, memory budget) was hit */
     GMPU_ERROR_CANCELLED = 7,        /* the progress callback returned non-zero */
     GMPU_ERROR_IO = 8,               /* a file could not be opened, read or written */
     GMPU_ERROR_PARSE = 9,            /* a file's contents are malformed or truncated */
     GMPU_ERROR_UNSUPPORTED = 10,     /* unknown file extension or format variant */
-    GMPU_ERROR_INTERNAL = 11         /* a bug: please report it with the message */
+    GMPU_ERROR_INTERNAL = 11,        /* a bug: please report it with the message */
+    GMPU_ERROR_BUSY = 12             /* a call on a surface from its own progress callback */
 } gmpu_status;
 
 /* The enumerator's name ("GMPU_ERROR_CANCELLED"), or "GMPU_UNKNOWN_STATUS". Never NULL;
@@ -144,7 +145,12 @@ typedef enum gmpu_param {
     /* Noise floor for ε: fit estimates the sampling noise σ̂ and works to
      * max(GMPU_PARAM_ERROR, NOISE_SCALE × σ̂), since fitting below the noise only fits the
      * noise; 0 turns the floor off. Discards a previous fit. Default 1.75, range [0, 20]. */
-    GMPU_PARAM_NOISE_SCALE = 11
+    GMPU_PARAM_NOISE_SCALE = 11,
+    /* Memory budget in bytes: fit and polygonize first estimate their peak memory (from the
+     * point count, the cell cap and the grid resolution) and fail with
+     * GMPU_ERROR_LIMIT_EXCEEDED, naming the estimate and the budget, instead of starting
+     * work the machine cannot hold. Default half the physical memory, range 1e6..1e15. */
+    GMPU_PARAM_MAX_MEMORY = 12
 } gmpu_param;
 
 typedef enum gmpu_stage {
@@ -169,9 +175,12 @@ typedef enum gmpu_stat {
     GMPU_STAT_ORIENT_SECONDS = 11,
     GMPU_STAT_POLYGONIZE_SECONDS = 12,
     GMPU_STAT_RESOLUTION = 13,        /* grid resolution the last polygonize used */
-    GMPU_STAT_BBOX_DIAGONAL = 14,     /* diagonal of the points' bounding box */
+    GMPU_STAT_BBOX_DIAGONAL = 14,     /* diagonal of the points' bounding box (outliers aside) */
     GMPU_STAT_NOISE = 15,             /* estimated noise σ̂, as a fraction of the diagonal */
-    GMPU_STAT_EFFECTIVE_ERROR = 16    /* the ε fit worked to, as a fraction of the diagonal */
+    GMPU_STAT_EFFECTIVE_ERROR = 16,   /* the ε fit worked to, as a fraction of the diagonal */
+    GMPU_STAT_OUTLIERS = 17           /* input points set aside as outliers by set_points: far
+                                       * from every other point compared with the cloud's
+                                       * spacing; they set no scale and join no fit */
 } gmpu_stat;
 
 /* Progress and cancellation. Called on the thread that called fit / orient / polygonize,
@@ -181,7 +190,9 @@ typedef enum gmpu_stat {
  * to go on; non-zero cancels: the call stops within 100 ms of work (CPU time of all its
  * threads) and returns GMPU_ERROR_CANCELLED, and the surface keeps the stages completed
  * before the cancelled one. The callback must not call gmpu functions on the same
- * surface. */
+ * surface: they return GMPU_ERROR_BUSY and do nothing (point_count and last_error answer);
+ * gmpu_surface_destroy is deferred until the stage returns, and cancels it. Other surfaces
+ * may be used freely. */
 typedef int (*gmpu_progress_fn)(void *user, gmpu_stage stage, double fraction);
 
 /* ---- surface: create, configure, destroy --------------------------------------------- */
@@ -218,11 +229,17 @@ GMPU_API gmpu_status gmpu_surface_set_progress(gmpu_surface *surface, gmpu_progr
 
 /* Copies count points, x y z each, from xyz; consecutive points are stride bytes apart
  * (0 means tightly packed: 3 × sizeof(double) or 3 × sizeof(float)). Replaces earlier
- * points and discards any fit, orientation and input normals.
- * Errors: INVALID_ARGUMENT (NULL, stride smaller than one point), INVALID_INPUT (fewer
+ * points and discards any fit, orientation and input normals. Outliers — points whose 4th
+ * nearest neighbour is over 20 times farther than is typical for the cloud — are set aside
+ * (GMPU_STAT_OUTLIERS): they neither set the scale (the bounding box, ε, the grid are the
+ * other points') nor join a fit; they still count as points for set_normals and
+ * copy_normals.
+ * Errors: INVALID_ARGUMENT (NULL, stride smaller than one point, count × stride beyond the
+ * address space), INVALID_INPUT (fewer
  * points than GMPU_PARAM_MIN_POINTS; a NaN or infinite coordinate, with its index; a
- * coordinate beyond ±1e300 or a cloud spanning less than 1e-300: they cannot be normalised),
- * DEGENERATE_INPUT (all points identical, collinear or coplanar: they bound no volume),
+ * coordinate beyond ±1e300 or a cloud spanning less than 1e-300: they cannot be normalised;
+ * clusters so far apart that the points' spacing is below a millionth of their extent:
+ * reconstruct each on its own surface), DEGENERATE_INPUT (all points identical, collinear or coplanar: they bound no volume),
  * OUT_OF_MEMORY. On failure the previous points are kept. Cost: O(n log n). */
 GMPU_API gmpu_status gmpu_surface_set_points_f64(gmpu_surface *surface, const double *xyz,
                                                  size_t count, size_t stride);
@@ -231,7 +248,8 @@ GMPU_API gmpu_status gmpu_surface_set_points_f32(gmpu_surface *surface, const fl
 
 /* Optional: outward normals for the points, same count and order. When given, orient
  * signs each local fit by agreement with them and belief propagation is skipped; they
- * need not be unit length, but must be finite and non-zero. Discards any orientation.
+ * need not be unit length (any finite, non-zero length: 1e-320 and 1e300 are fine).
+ * Discards any orientation.
  * Errors: INVALID_ARGUMENT, WRONG_ORDER (no points yet), INVALID_INPUT (count differs from
  * the point count; NaN, inf or zero normal, with its index). */
 GMPU_API gmpu_status gmpu_surface_set_normals_f64(gmpu_surface *surface, const double *nxyz,
@@ -249,7 +267,7 @@ GMPU_API size_t gmpu_surface_point_count(const gmpu_surface *surface);
  * frame, piecewise quadrics at sharp features; cells are subdivided until the Taubin
  * error is below ε = max(GMPU_PARAM_ERROR, GMPU_PARAM_NOISE_SCALE × estimated noise).
  * Discards a previous orientation.
- * Errors: WRONG_ORDER (no points), LIMIT_EXCEEDED (GMPU_PARAM_MAX_CELLS), CANCELLED,
+ * Errors: WRONG_ORDER (no points), LIMIT_EXCEEDED (GMPU_PARAM_MAX_CELLS, GMPU_PARAM_MAX_MEMORY), CANCELLED,
  * OUT_OF_MEMORY. Cost: about O(n log n); 35k points take ~0.1 s on 2 cores. */
 GMPU_API gmpu_status gmpu_surface_fit(gmpu_surface *surface);
 
@@ -269,8 +287,8 @@ GMPU_API gmpu_status gmpu_surface_orient(gmpu_surface *surface);
  * input point, signed by the winding number of the oriented points where it is clearly 0
  * or 1 and by the nearby points' normals elsewhere: never zero there, so no surface.
  * Honours GMPU_PARAM_LEVEL. Safe to call from several threads at once after orient.
- * Errors: INVALID_ARGUMENT (NULL), WRONG_ORDER (not oriented), INVALID_INPUT (a NaN or
- * infinite query, with its index; outputs untouched). Cost: O(count × log cells). */
+ * Errors: INVALID_ARGUMENT (NULL; a count whose 3 × count doubles overflow), WRONG_ORDER
+ * (not oriented), INVALID_INPUT (a NaN or infinite query, with its index; outputs untouched). Cost: O(count × log cells). */
 GMPU_API gmpu_status gmpu_surface_evaluate(const gmpu_surface *surface, const double *xyz,
                                            size_t count, double *values, double *gradients);
 
@@ -284,8 +302,10 @@ GMPU_API gmpu_status gmpu_surface_copy_normals(const gmpu_surface *surface, doub
  * (counter-clockwise seen from outside), restricted to a band around the data so that
  * spurious zero sets of far-away quadrics never become surface. Uses
  * GMPU_PARAM_RESOLUTION and GMPU_PARAM_LEVEL. The mesh is the caller's: free it with
- * gmpu_mesh_destroy. Errors: INVALID_ARGUMENT, WRONG_ORDER (not oriented),
- * LIMIT_EXCEEDED (GMPU_PARAM_MAX_TRIANGLES), CANCELLED, OUT_OF_MEMORY. */
+ * gmpu_mesh_destroy. Never an empty mesh: when no piece of surface is near the points (too
+ * few or too sparse for a solid, or a grid too coarse for them) it fails with
+ * DEGENERATE_INPUT. Errors: INVALID_ARGUMENT, WRONG_ORDER (not oriented), DEGENERATE_INPUT,
+ * LIMIT_EXCEEDED (GMPU_PARAM_MAX_TRIANGLES, GMPU_PARAM_MAX_MEMORY), CANCELLED, OUT_OF_MEMORY. */
 GMPU_API gmpu_status gmpu_surface_polygonize(gmpu_surface *surface, gmpu_mesh **out);
 
 /* ---- meshes -------------------------------------------------------------------------- */

@@ -19,7 +19,9 @@ GMPU_API gmpu_status gmpu_mesh_create(const double *vertices, size_t vertex_coun
     return gmpu::api::guarded(nullptr, [&] {
         gmpu::api::require_arg(out, "out");
         *out = nullptr;
-        if (vertex_count > SIZE_MAX / (3 * sizeof(double)) || triangle_count > SIZE_MAX / (3 * sizeof(uint32_t)))
+        // Arrays of 3 × count elements must be addressable (a std::vector holds at most
+        // PTRDIFF_MAX bytes), and 32-bit indices address at most 2^32 vertices.
+        if (vertex_count > (size_t(1) << 32) || triangle_count > size_t(PTRDIFF_MAX) / (3 * sizeof(uint32_t)))
             throw Error(GMPU_ERROR_INVALID_ARGUMENT, "count is too large");
         if (vertex_count > 0) gmpu::api::require_arg(vertices, "vertices");
         if (triangle_count > 0) gmpu::api::require_arg(triangles, "triangles");

@@ -42,7 +42,7 @@ GMPU_API gmpu_status gmpu_points_create(const double *xyz, const double *normals
     return gmpu::api::guarded(nullptr, [&] {
         gmpu::api::require_arg(out, "out");
         *out = nullptr;
-        if (count > SIZE_MAX / (3 * sizeof(double)))
+        if (count > size_t(PTRDIFF_MAX) / (3 * sizeof(double)))
             throw Error(GMPU_ERROR_INVALID_ARGUMENT, "count is too large");
         if (count == 0) throw Error(GMPU_ERROR_INVALID_INPUT, "no points");
         gmpu::api::require_arg(xyz, "xyz");

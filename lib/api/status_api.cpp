@@ -24,6 +24,7 @@ GMPU_API const char *gmpu_status_name(gmpu_status status) {
         case GMPU_ERROR_PARSE: return "GMPU_ERROR_PARSE";
         case GMPU_ERROR_UNSUPPORTED: return "GMPU_ERROR_UNSUPPORTED";
         case GMPU_ERROR_INTERNAL: return "GMPU_ERROR_INTERNAL";
+        case GMPU_ERROR_BUSY: return "GMPU_ERROR_BUSY";
     }
     return "GMPU_UNKNOWN_STATUS";
 }

@@ -20,6 +20,7 @@
 #include "core/release_memory.hpp"
 #include "fit/build_octree.hpp"
 #include "fit/noise_estimate.hpp"
+#include "geometry/outliers.hpp"
 #include "geometry/point_set.hpp"
 #include "implicit/mpu_function.hpp"
 #include "implicit/surface_field.hpp"
@@ -35,7 +36,10 @@ struct gmpu_surface {
     enum class Stage { empty, points, fitted, oriented };
     Stage stage = Stage::empty;
     gmpu::Params params;
-    gmpu::PointSet points;
+    gmpu::PointSet points;             // the input points less the outliers
+    size_t input_count = 0;            // points given to set_points, outliers included
+    std::vector<uint32_t> outliers;        // input indices set aside, increasing
+    std::vector<uint32_t> outlier_nearest; // per outlier: the nearest kept point
     std::vector<float> input_normals;  // unit, 3 per point; empty when none were given
     gmpu::Octree tree;
     gmpu::PointMeasures measures;      // oriented normals, areas, trust radii per point
@@ -47,6 +51,11 @@ struct gmpu_surface {
     double seconds[4] = {0, 0, 0, 0};  // by gmpu_stage
     int last_resolution = 0;
     double noise = 0.0, epsilon = 0.0;  // of the last fit, normalised units
+    // The stage running on this surface (0 when none). Its progress callback may call back
+    // into gmpu; a call on this same surface would free or rebuild what the stage is using,
+    // so every such call is refused with BUSY, and destroy is deferred to the stage's end.
+    int running_stage = 0;
+    bool destroy_when_idle = false;
 
     void discard_fit() {
         if (stage > Stage::points) stage = Stage::points;
@@ -54,6 +63,13 @@ struct gmpu_surface {
         measures = gmpu::PointMeasures();
         winding = gmpu::WindingField();
         orient_stats = {};
+    }
+    void require_idle(const char *verb) const {
+        static const char *const names[] = {"", "gmpu_surface_fit", "gmpu_surface_orient", "gmpu_surface_polygonize"};
+        if (running_stage != 0)
+            throw Error(GMPU_ERROR_BUSY, std::string(verb) + " was called on a surface whose " +
+                                             names[running_stage] +
+                                             " is running (from its progress callback); call it after the stage returns");
     }
     void require(Stage needed, const char *verb, const char *missing) const {
         if (stage < needed)
@@ -72,10 +88,27 @@ double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::
 // here, except a cancelled one, which the caller wants back at once (the next stage or
 // destroy hands the memory back).
 template <class Body>
-gmpu_status run_stage(gmpu_surface *s, Body &&body) noexcept {
-    const gmpu_status status = guarded(s ? &s->last_error : nullptr, std::forward<Body>(body));
+gmpu_status run_stage(gmpu_surface *s, gmpu_stage stage, const char *verb, Body &&body) noexcept {
+    if (s && s->running_stage != 0)  // re-entered from the running stage's callback
+        return guarded(nullptr, [&] { s->require_idle(verb); });
+    if (s) s->running_stage = int(stage);
+    gmpu_status status = guarded(s ? &s->last_error : nullptr, std::forward<Body>(body));
+    if (s) {
+        s->running_stage = 0;
+        // The callback destroyed the surface: the stage was cancelled at that report (or had
+        // just completed, and its mesh is the caller's); the surface goes now.
+        if (s->destroy_when_idle) delete s;
+    }
     if (status != GMPU_OK && status != GMPU_ERROR_CANCELLED) gmpu::release_free_memory();
     return status;
+}
+
+// Progress that also stops the stage once its surface is to be destroyed.
+int progress_or_stop(void *surface, gmpu_stage stage, double fraction) {
+    auto *s = static_cast<gmpu_surface *>(surface);
+    if (s->destroy_when_idle) return 1;
+    const int answer = s->progress_fn ? s->progress_fn(s->progress_user, stage, fraction) : 0;
+    return s->destroy_when_idle ? 1 : answer;
 }
 
 // The end of a successful stage, before it commits its result. The temporaries are freed by
@@ -112,12 +145,12 @@ struct ParamSpec {
 // Unknown keys are rejected as ints, before the enum is loaded (see enum_int).
 void check_key(const gmpu_param &key) {
     const int v = gmpu::api::enum_int(key);
-    if (v < GMPU_PARAM_ERROR || v > GMPU_PARAM_NOISE_SCALE)  // the first and the last key
+    if (v < GMPU_PARAM_ERROR || v > GMPU_PARAM_MAX_MEMORY)  // the first and the last key
         throw Error(GMPU_ERROR_INVALID_ARGUMENT, "unknown parameter key " + std::to_string(v));
 }
 void check_key(const gmpu_stat &key) {
     const int v = gmpu::api::enum_int(key);
-    if (v < GMPU_STAT_POINTS || v > GMPU_STAT_EFFECTIVE_ERROR)  // the first and the last key
+    if (v < GMPU_STAT_POINTS || v > GMPU_STAT_OUTLIERS)  // the first and the last key
         throw Error(GMPU_ERROR_INVALID_ARGUMENT, "unknown statistic key " + std::to_string(v));
 }
 
@@ -134,6 +167,7 @@ ParamSpec spec(gmpu_param key) {
         case GMPU_PARAM_MAX_CELLS: return {1, 1e9, true, true, "GMPU_PARAM_MAX_CELLS"};
         case GMPU_PARAM_MAX_TRIANGLES: return {1, 2e9, true, false, "GMPU_PARAM_MAX_TRIANGLES"};
         case GMPU_PARAM_NOISE_SCALE: return {0, 20, false, true, "GMPU_PARAM_NOISE_SCALE"};
+        case GMPU_PARAM_MAX_MEMORY: return {1e6, 1e15, true, false, "GMPU_PARAM_MAX_MEMORY"};
     }
     throw Error(GMPU_ERROR_INVALID_ARGUMENT, "unknown parameter key " + std::to_string(int(key)));
 }
@@ -145,6 +179,7 @@ double *param_slot(gmpu::Params &p, gmpu_param key, double &scratch) {
         case GMPU_PARAM_MAX_CELLS: return &p.max_cells;
         case GMPU_PARAM_MAX_TRIANGLES: return &p.max_triangles;
         case GMPU_PARAM_NOISE_SCALE: return &p.noise_scale;
+        case GMPU_PARAM_MAX_MEMORY: return &p.max_memory;
         default: return &scratch;  // integer-valued: converted by the caller
     }
 }
@@ -162,6 +197,7 @@ double get_param(const gmpu::Params &p, gmpu_param key) {
         case GMPU_PARAM_MAX_CELLS: return p.max_cells;
         case GMPU_PARAM_MAX_TRIANGLES: return p.max_triangles;
         case GMPU_PARAM_NOISE_SCALE: return p.noise_scale;
+        case GMPU_PARAM_MAX_MEMORY: return p.max_memory;
     }
     throw Error(GMPU_ERROR_INVALID_ARGUMENT, "unknown parameter key " + std::to_string(int(key)));
 }
@@ -204,18 +240,86 @@ void check_array(const void *data, size_t count, size_t stride, size_t element, 
                                                      " is smaller than one point (" + std::to_string(element) +
                                                      " bytes)");
     size_t s = stride ? stride : element;
-    if (count > std::numeric_limits<size_t>::max() / s || count > std::numeric_limits<uint32_t>::max() / 4)
+    // The last point ends at (count - 1) × stride + element bytes: that must be addressable.
+    if (count > 0 && (count - 1 > (std::numeric_limits<size_t>::max() - element) / s ||
+                      count > std::numeric_limits<uint32_t>::max() / 4))
         throw Error(GMPU_ERROR_INVALID_ARGUMENT, std::string(what) + ": too many points");
+}
+
+Error clusters(const gmpu::OutlierScan &scan) {
+    return Error(GMPU_ERROR_INVALID_INPUT, "the points are spaced " + number(scan.spacing) +
+                                               " apart over an extent of " + number(scan.extent) +
+                                               ": clusters this far apart cannot share one surface's scale; "
+                                               "reconstruct each cluster on its own surface");
+}
+
+// The points as given; when they look collinear or coplanar, says so unless they are
+// far-apart clusters (which look so from afar).
+template <class T>
+gmpu::PointSet points_or_clusters(const T *xyz, size_t count, size_t stride, size_t min_points) {
+    try {
+        return gmpu::PointSet::from_array(xyz, count, stride, min_points);
+    } catch (const Error &e) {
+        if (e.status() != GMPU_ERROR_DEGENERATE_INPUT) throw;
+        const gmpu::OutlierScan full = gmpu::find_outliers(xyz, count, stride, false);
+        if (full.spacing > 0.0 && full.spacing < 1e-6 * full.extent) throw clusters(full);
+        throw;
+    }
+}
+
+// The points less the outliers: the scale comes from them, and only they join the fits.
+// nearest[k]: the kept point nearest to outlier k (its normal stands in for the outlier's).
+template <class T>
+gmpu::PointSet kept_points(const T *xyz, size_t count, size_t stride, size_t min_points,
+                           const std::vector<uint32_t> &outliers, std::vector<uint32_t> &nearest) {
+    const size_t step = stride ? stride : 3 * sizeof(T);
+    const auto *bytes = reinterpret_cast<const unsigned char *>(xyz);
+    auto read = [&](size_t i, T v[3]) { std::memcpy(v, bytes + i * step, 3 * sizeof(T)); };
+    std::vector<T> kept;
+    kept.reserve(3 * (count - outliers.size()));
+    size_t next = 0;
+    for (size_t i = 0; i < count; ++i) {
+        if (next < outliers.size() && outliers[next] == i) {
+            ++next;
+            continue;
+        }
+        T v[3];
+        read(i, v);
+        kept.insert(kept.end(), v, v + 3);
+    }
+    gmpu::PointSet points = gmpu::PointSet::from_array(kept.data(), kept.size() / 3, 0, min_points);
+    points.set_outlier_count(outliers.size());
+    std::vector<uint32_t> idx;
+    std::vector<float> d2;
+    for (uint32_t o : outliers) {
+        T v[3];
+        read(o, v);
+        const Eigen::Vector3d q = points.normalisation().to_unit({double(v[0]), double(v[1]), double(v[2])});
+        points.nearest(q.cwiseMax(-1e15).cwiseMin(1e15), 1, idx, d2);
+        nearest.push_back(idx.empty() ? 0 : idx[0]);
+    }
+    return points;
 }
 
 template <class T>
 gmpu_status set_points(gmpu_surface *s, const T *xyz, size_t count, size_t stride) {
     return guarded(s ? &s->last_error : nullptr, [&] {
         require_arg(s, "surface");
+        s->require_idle("gmpu_surface_set_points");
         check_array(xyz, count, stride, 3 * sizeof(T), "xyz");
-        gmpu::PointSet points = gmpu::PointSet::from_array(xyz, count, stride, size_t(s->params.min_points));
+        const size_t min_points = size_t(s->params.min_points);
+        gmpu::OutlierScan scan = gmpu::find_outliers(xyz, count, stride);
+        // The points' own spacing, not their bounding box, is the scale of the detail: one
+        // octree in float coordinates resolves about a millionth of the extent.
+        if (scan.spacing > 0.0 && scan.spacing < 1e-6 * scan.extent) throw clusters(scan);
+        std::vector<uint32_t> nearest;
+        gmpu::PointSet points = scan.outliers.empty() ? points_or_clusters(xyz, count, stride, min_points)
+                                                      : kept_points(xyz, count, stride, min_points, scan.outliers, nearest);
         s->discard_fit();
         s->points = std::move(points);
+        s->input_count = count;
+        s->outliers = std::move(scan.outliers);
+        s->outlier_nearest = std::move(nearest);
         s->input_normals.clear();
         s->stage = gmpu_surface::Stage::points;
     });
@@ -225,23 +329,35 @@ template <class T>
 gmpu_status set_normals(gmpu_surface *s, const T *nxyz, size_t count, size_t stride) {
     return guarded(s ? &s->last_error : nullptr, [&] {
         require_arg(s, "surface");
+        s->require_idle("gmpu_surface_set_normals");
         s->require(gmpu_surface::Stage::points, "gmpu_surface_set_normals", "gmpu_surface_set_points");
         check_array(nxyz, count, stride, 3 * sizeof(T), "nxyz");
-        if (count != s->points.size())
+        if (count != s->input_count)
             throw Error(GMPU_ERROR_INVALID_INPUT, std::to_string(count) + " normals given for " +
-                                                      std::to_string(s->points.size()) + " points");
+                                                      std::to_string(s->input_count) + " points");
         if (stride == 0) stride = 3 * sizeof(T);
-        std::vector<float> unit(3 * count);
+        std::vector<float> unit;
+        unit.reserve(3 * s->points.size());
+        size_t next_outlier = 0;
         const auto *bytes = reinterpret_cast<const unsigned char *>(nxyz);
         for (size_t i = 0; i < count; ++i) {
             T v[3];
             std::memcpy(v, bytes + i * stride, sizeof v);
             Eigen::Vector3d n{double(v[0]), double(v[1]), double(v[2])};
-            double len = n.norm();
-            if (!n.allFinite() || !std::isfinite(len) || !(len > 0.0))
-                throw Error(GMPU_ERROR_INVALID_INPUT,
-                            "normal " + std::to_string(i) + " is " + (n.allFinite() ? "zero" : "NaN or infinite"));
-            for (int d = 0; d < 3; ++d) unit[3 * i + d] = float(n[d] / len);
+            if (!n.allFinite())
+                throw Error(GMPU_ERROR_INVALID_INPUT, "normal " + std::to_string(i) + " is NaN or infinite");
+            // Only the direction matters: divide by the largest component first, so that
+            // squaring neither underflows (1e-320) nor overflows (1e200).
+            const double largest = n.cwiseAbs().maxCoeff();
+            if (!(largest > 0.0))
+                throw Error(GMPU_ERROR_INVALID_INPUT, "normal " + std::to_string(i) + " is zero");
+            n /= largest;
+            n /= n.norm();
+            if (next_outlier < s->outliers.size() && s->outliers[next_outlier] == i) {
+                ++next_outlier;  // validated like the others, but no fit is near it
+                continue;
+            }
+            for (int d = 0; d < 3; ++d) unit.push_back(float(n[d]));
         }
         s->input_normals.swap(unit);
         if (s->stage > gmpu_surface::Stage::fitted) s->stage = gmpu_surface::Stage::fitted;
@@ -262,6 +378,10 @@ GMPU_API gmpu_status gmpu_surface_create(gmpu_surface **out) {
 
 GMPU_API void gmpu_surface_destroy(gmpu_surface *s) {
     if (!s) return;
+    if (s->running_stage != 0) {  // from the stage's own callback: run_stage deletes it
+        s->destroy_when_idle = true;
+        return;
+    }
     delete s;
     gmpu::release_free_memory();
 }
@@ -271,6 +391,7 @@ GMPU_API const char *gmpu_surface_last_error(const gmpu_surface *s) { return s ?
 GMPU_API gmpu_status gmpu_surface_set_param(gmpu_surface *s, gmpu_param key, double value) {
     return guarded(s ? &s->last_error : nullptr, [&] {
         require_arg(s, "surface");
+        s->require_idle("gmpu_surface_set_param");
         check_key(key);
         gmpu::Params p = s->params;
         set_param(p, key, value);
@@ -283,6 +404,7 @@ GMPU_API gmpu_status gmpu_surface_get_param(const gmpu_surface *s, gmpu_param ke
     return guarded(nullptr, [&] {
         require_arg(s, "surface");
         require_arg(value, "value");
+        s->require_idle("gmpu_surface_get_param");
         check_key(key);
         *value = get_param(s->params, key);
     });
@@ -292,6 +414,7 @@ GMPU_API gmpu_status gmpu_surface_get_stat(const gmpu_surface *s, gmpu_stat key,
     return guarded(nullptr, [&] {
         require_arg(s, "surface");
         require_arg(value, "value");
+        s->require_idle("gmpu_surface_get_stat");
         check_key(key);
         const auto &cells = s->tree.cells;
         auto leaves_where = [&](auto pred) {
@@ -300,7 +423,7 @@ GMPU_API gmpu_status gmpu_surface_get_stat(const gmpu_surface *s, gmpu_stat key,
             return n;
         };
         switch (key) {
-            case GMPU_STAT_POINTS: *value = double(s->points.size()); break;
+            case GMPU_STAT_POINTS: *value = double(s->input_count); break;
             case GMPU_STAT_CELLS: *value = double(cells.size()); break;
             case GMPU_STAT_LEAVES: *value = leaves_where([](const gmpu::Cell &) { return true; }); break;
             case GMPU_STAT_DEPTH: {
@@ -326,6 +449,7 @@ GMPU_API gmpu_status gmpu_surface_get_stat(const gmpu_surface *s, gmpu_stat key,
             case GMPU_STAT_ORIENT_SECONDS: *value = s->seconds[GMPU_STAGE_ORIENT]; break;
             case GMPU_STAT_POLYGONIZE_SECONDS: *value = s->seconds[GMPU_STAGE_POLYGONIZE]; break;
             case GMPU_STAT_RESOLUTION: *value = s->last_resolution; break;
+            case GMPU_STAT_OUTLIERS: *value = double(s->points.outlier_count()); break;
             case GMPU_STAT_BBOX_DIAGONAL: *value = s->points.empty() ? 0.0 : s->points.world_diagonal(); break;
             case GMPU_STAT_NOISE:
             case GMPU_STAT_EFFECTIVE_ERROR: {
@@ -343,6 +467,7 @@ GMPU_API gmpu_status gmpu_surface_get_stat(const gmpu_surface *s, gmpu_stat key,
 GMPU_API gmpu_status gmpu_surface_set_progress(gmpu_surface *s, gmpu_progress_fn fn, void *user) {
     return guarded(s ? &s->last_error : nullptr, [&] {
         require_arg(s, "surface");
+        s->require_idle("gmpu_surface_set_progress");
         s->progress_fn = fn;
         s->progress_user = user;
     });
@@ -361,14 +486,14 @@ GMPU_API gmpu_status gmpu_surface_set_normals_f32(gmpu_surface *s, const float *
     return set_normals(s, n, count, stride);
 }
 
-GMPU_API size_t gmpu_surface_point_count(const gmpu_surface *s) { return s ? s->points.size() : 0; }
+GMPU_API size_t gmpu_surface_point_count(const gmpu_surface *s) { return s ? s->input_count : 0; }
 
 GMPU_API gmpu_status gmpu_surface_fit(gmpu_surface *s) {
-    return run_stage(s, [&] {
+    return run_stage(s, GMPU_STAGE_FIT, "gmpu_surface_fit", [&] {
         require_arg(s, "surface");
         s->require(gmpu_surface::Stage::points, "gmpu_surface_fit", "gmpu_surface_set_points");
         auto t0 = Clock::now();
-        gmpu::Progress progress(s->progress_fn, s->progress_user, GMPU_STAGE_FIT);
+        gmpu::Progress progress(s->progress_fn ? progress_or_stop : nullptr, s, GMPU_STAGE_FIT);
         progress.report(0.0, true);
         const double noise = gmpu::estimate_noise(s->points, progress);
         const double epsilon = gmpu::effective_epsilon(s->points, s->params, noise);
@@ -384,11 +509,11 @@ GMPU_API gmpu_status gmpu_surface_fit(gmpu_surface *s) {
 }
 
 GMPU_API gmpu_status gmpu_surface_orient(gmpu_surface *s) {
-    return run_stage(s, [&] {
+    return run_stage(s, GMPU_STAGE_ORIENT, "gmpu_surface_orient", [&] {
         require_arg(s, "surface");
         s->require(gmpu_surface::Stage::fitted, "gmpu_surface_orient", "gmpu_surface_fit");
         auto t0 = Clock::now();
-        gmpu::Progress progress(s->progress_fn, s->progress_user, GMPU_STAGE_ORIENT);
+        gmpu::Progress progress(s->progress_fn ? progress_or_stop : nullptr, s, GMPU_STAGE_ORIENT);
         progress.report(0.0, true);
         // Orient only writes the cells' signs and resets them first, so a cancelled or failed
         // orient leaves a fit that the next orient can use as it is.
@@ -419,6 +544,10 @@ GMPU_API gmpu_status gmpu_surface_evaluate(const gmpu_surface *s, const double *
         require_arg(s, "surface");
         if (count > 0) require_arg(xyz, "xyz");
         if (!values && !gradients) throw Error(GMPU_ERROR_INVALID_ARGUMENT, "values and gradients are both NULL");
+        s->require_idle("gmpu_surface_evaluate");
+        if (count > std::numeric_limits<size_t>::max() / (3 * sizeof(double)))
+            throw Error(GMPU_ERROR_INVALID_ARGUMENT, "count " + std::to_string(count) +
+                                                         " is too large: 3 × count doubles do not fit in memory");
         s->require(gmpu_surface::Stage::oriented, "gmpu_surface_evaluate", "gmpu_surface_orient");
         for (size_t i = 0; i < 3 * count; ++i)
             if (!std::isfinite(xyz[i]))
@@ -444,27 +573,42 @@ GMPU_API gmpu_status gmpu_surface_copy_normals(const gmpu_surface *s, double *ou
     return guarded(nullptr, [&] {
         require_arg(s, "surface");
         require_arg(out, "out");
+        s->require_idle("gmpu_surface_copy_normals");
         s->require(gmpu_surface::Stage::oriented, "gmpu_surface_copy_normals", "gmpu_surface_orient");
-        if (count != s->points.size())
+        if (count != s->input_count)
             throw Error(GMPU_ERROR_INVALID_ARGUMENT, "count " + std::to_string(count) + " differs from the " +
-                                                         std::to_string(s->points.size()) + " points");
-        for (size_t i = 0; i < 3 * count; ++i) out[i] = double(s->measures.normals[i]);
+                                                         std::to_string(s->input_count) + " points");
+        // An outlier takes the normal of the kept point nearest to it.
+        size_t next_outlier = 0, kept = 0;
+        for (size_t i = 0; i < count; ++i) {
+            size_t from;
+            if (next_outlier < s->outliers.size() && s->outliers[next_outlier] == i)
+                from = s->outlier_nearest[next_outlier++];
+            else
+                from = kept++;
+            for (int d = 0; d < 3; ++d) out[3 * i + d] = double(s->measures.normals[3 * from + d]);
+        }
     });
 }
 
 GMPU_API gmpu_status gmpu_surface_polygonize(gmpu_surface *s, gmpu_mesh **out) {
-    return run_stage(s, [&] {
+    return run_stage(s, GMPU_STAGE_POLYGONIZE, "gmpu_surface_polygonize", [&] {
         require_arg(s, "surface");
         require_arg(out, "out");
         *out = nullptr;
         s->require(gmpu_surface::Stage::oriented, "gmpu_surface_polygonize", "gmpu_surface_orient");
         auto t0 = Clock::now();
-        gmpu::Progress progress(s->progress_fn, s->progress_user, GMPU_STAGE_POLYGONIZE);
+        gmpu::Progress progress(s->progress_fn ? progress_or_stop : nullptr, s, GMPU_STAGE_POLYGONIZE);
         progress.report(0.0, true);
         int resolution = s->params.resolution > 0 ? s->params.resolution : gmpu::default_resolution(s->tree);
         const gmpu::MpuFunction mpu(s->tree, s->params.level);
         auto mesh = std::make_unique<gmpu_mesh>();
         mesh->mesh = gmpu::polygonize(mpu, s->winding, s->points, s->measures, resolution, s->params, progress);
+        if (mesh->mesh.triangle_count() == 0)
+            throw Error(GMPU_ERROR_DEGENERATE_INPUT,
+                        "polygonize found no closed surface at resolution " + std::to_string(resolution) +
+                            " (no piece of the zero set is near enough input points): the points may be "
+                            "too few or too sparse for a solid, or the grid too coarse for them");
         finish_stage(progress);
         s->last_resolution = resolution;
         s->seconds[GMPU_STAGE_POLYGONIZE] = since(t0);

@@ -51,12 +51,21 @@ void parallel_for(size_t begin, size_t end, unsigned threads, Progress &progress
     unsigned n = std::max(1u, std::min<unsigned>(threads, unsigned((end - begin + chunk - 1) / chunk)));
     std::vector<std::thread> pool;
     pool.reserve(n - 1);
-    active.store(n - 1);
-    for (unsigned t = 1; t < n; ++t)
-        pool.emplace_back([&] {
-            work(false);
+    for (unsigned t = 1; t < n; ++t) {
+        active.fetch_add(1);
+        try {
+            pool.emplace_back([&] {
+                work(false);
+                active.fetch_sub(1);
+            });
+        } catch (...) {
+            // The system refused a thread (a pids or process limit, no memory for a stack):
+            // the threads already running and the caller share the work instead. Letting the
+            // exception out here would destroy joinable threads, which terminates.
             active.fetch_sub(1);
-        });
+            break;
+        }
+    }
     work(true);
     // The caller keeps reporting (and so keeps cancellation responsive) while the last
     // chunks finish on the other threads.

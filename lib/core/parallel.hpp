@@ -1,7 +1,8 @@
 // parallel_for over an index range with the calling thread taking part: it alone reports
 // progress, so user callbacks stay on the caller's thread. Work is handed out in small
 // chunks from an atomic counter; every worker stops at its next chunk once the progress
-// is cancelled. Exceptions thrown by the body are re-thrown on the calling thread.
+// is cancelled. Exceptions thrown by the body are re-thrown on the calling thread. When the
+// system refuses to create a thread, the loop runs on the threads it has (at least the caller).
 #pragma once
 
 #include <cstddef>

@@ -1,6 +1,8 @@
 // Every tunable of the pipeline, with the defaults the C ABI documents (gmpu.h).
 #pragma once
 
+#include "core/memory_budget.hpp"
+
 namespace gmpu {
 
 struct Params {
@@ -15,6 +17,7 @@ struct Params {
     unsigned threads = 0;          // 0 = every core
     double max_cells = 2e7;        // fit fails beyond this many cells
     double max_triangles = 1e8;    // polygonize fails beyond this many triangles
+    double max_memory = default_memory_budget();  // bytes a stage may estimate to need
 };
 
 }  // namespace gmpu

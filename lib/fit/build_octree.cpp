@@ -6,6 +6,7 @@
 #include <numeric>
 #include <string>
 
+#include "core/memory_budget.hpp"
 #include "core/parallel.hpp"
 #include "fit/cell_fit.hpp"
 
@@ -20,6 +21,19 @@ constexpr double kFullSupport = 16384;
 // (ε / error)^kStrandedPower: where finer leaves reach, they decide; where none does, it
 // still stands in.
 constexpr double kStrandedPower = 2.0;
+
+// Memory model of fit, for GMPU_PARAM_MAX_MEMORY (upper estimates of the peak): per point,
+// the points and their kd-trees and the octree's order; per cell, the cell, its copy among
+// a level's children while they are made, and the cells vector's growth slack.
+constexpr double kFitBytesPerPoint = 48;
+constexpr double kFitBytesPerCell = 3 * sizeof(Cell);
+
+void check_fit_memory(size_t points, double cells, double budget) {
+    const double estimate = double(points) * kFitBytesPerPoint + cells * kFitBytesPerCell;
+    if (estimate <= budget) return;  // the message only when it fails: this runs per cell
+    const std::string what = "fit (" + std::to_string(points) + " points, " + std::to_string(uint64_t(cells)) + " cells)";
+    check_memory(estimate, budget, what.c_str());
+}
 
 struct Builder {
     const PointSet &points;
@@ -149,6 +163,7 @@ struct Builder {
 
     Octree run() {
         const size_t n = points.size();
+        check_fit_memory(n, 1, params.max_memory);
         tree.order.resize(n);
         std::iota(tree.order.begin(), tree.order.end(), 0u);
 
@@ -178,7 +193,9 @@ struct Builder {
             // the caller reports progress (and sees a cancel) only between chunks.
             parallel_for(0, level.size(), threads, progress, [&](size_t i) {
                 kids[i] = make_children(tree.cells[level[i]]);
-                if (double(made += kids[i].size()) > params.max_cells) too_many_cells();
+                const double cells = double(made += kids[i].size());
+                if (cells > params.max_cells) too_many_cells();
+                check_fit_memory(n, cells, params.max_memory);
             }, settled * total, total, 1);
             progress.throw_if_cancelled();
 

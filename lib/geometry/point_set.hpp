@@ -45,6 +45,9 @@ public:
     const Eigen::Vector3d &box_min() const { return box_min_; }
     const Eigen::Vector3d &box_max() const { return box_max_; }
     double world_diagonal() const { return world_diagonal_; }
+    // Input points set aside as outliers (see outliers.hpp); they are not in this set.
+    size_t outlier_count() const { return outlier_count_; }
+    void set_outlier_count(size_t n) { outlier_count_ = n; }
 
     // Indices of the points within `radius` of `centre` (normalised frame), appended to out.
     void within(const Eigen::Vector3d &centre, double radius, std::vector<uint32_t> &out) const;
@@ -68,6 +71,7 @@ private:
     Normalisation norm_;
     Eigen::Vector3d box_min_, box_max_;
     double world_diagonal_ = 0.0;
+    size_t outlier_count_ = 0;
     std::unique_ptr<Index> index_, coarse_index_;
     std::vector<uint32_t> coarse_ids_;
     double coarse_ratio_ = 1.0;

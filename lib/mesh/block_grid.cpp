@@ -5,16 +5,28 @@
 
 namespace gmpu {
 
+namespace {
+// Spare blocks beyond the widest reach keep the band off the grid's edge, so the region
+// touching the edge surrounds everything. Two, not one: mark_band widens its boxes a hair,
+// so with one a point at the box's edge marked block 0, the band reached the grid's edge
+// and a surface crossing it was left open (fuzz_pipeline found it with garbage normals).
+double grid_pad(double widest, double h) { return widest + 2 * BlockGrid::B * h; }
+}  // namespace
+
+double BlockGrid::blocks_for(const PointSet &points, int resolution, double widest) {
+    const double h = 1.0 / resolution, pad = grid_pad(widest, h);
+    double blocks = 1.0;
+    for (int d = 0; d < 3; ++d)
+        blocks *= std::max(1.0, std::ceil((points.box_max()[d] - points.box_min()[d] + 2.0 * pad) / (h * B)));
+    return blocks;
+}
+
 BlockGrid::BlockGrid(const PointSet &points, int resolution, const std::vector<float> &reach, double min_reach,
                      const WindingField &winding, Progress &progress) {
     h = 1.0 / resolution;  // the longest side of the normalised box is 1
     double widest = min_reach;
     for (float r : reach) widest = std::max(widest, double(r));
-    // Spare blocks beyond the widest reach keep the band off the grid's edge, so the region
-    // touching the edge surrounds everything. Two, not one: mark_band widens its boxes a hair,
-    // so with one a point at the box's edge marked block 0, the band reached the grid's edge
-    // and a surface crossing it was left open (fuzz_pipeline found it with garbage normals).
-    const double pad = widest + 2 * B * h;
+    const double pad = grid_pad(widest, h);
     origin = points.box_min() - Eigen::Vector3d::Constant(pad);
     for (int d = 0; d < 3; ++d) {
         double extent = points.box_max()[d] - points.box_min()[d] + 2.0 * pad;

@@ -32,6 +32,10 @@ struct BlockGrid {
     BlockGrid(const PointSet &points, int resolution, const std::vector<float> &reach, double min_reach,
               const WindingField &winding, Progress &progress);
 
+    // Blocks of the grid the constructor would make, with `widest` the largest reach: known
+    // before the grid is allocated, for the memory estimate.
+    static double blocks_for(const PointSet &points, int resolution, double widest);
+
     Eigen::Vector3d corner(int64_t x, int64_t y, int64_t z) const {
         return origin + h * Eigen::Vector3d(double(x), double(y), double(z));
     }

@@ -6,6 +6,7 @@
 #include <string>
 
 #include "core/cancellable_sort.hpp"
+#include "core/memory_budget.hpp"
 #include "core/parallel.hpp"
 #include "mesh/block_grid.hpp"
 #include "mesh/marching_tetrahedra.hpp"
@@ -25,6 +26,25 @@ constexpr uint32_t kMinVotes = 15;
 constexpr double kCubesPerGap = 0.4;
 // Share of the points that two-sheet leaves must hold for their gap to set the grid.
 constexpr double kWallShare = 0.1;
+
+// Memory model of polygonize, for GMPU_PARAM_MAX_MEMORY (upper estimates of the peak):
+//  - per grid block: the band flag, the far sign, the region label and flood-fill stack;
+//  - per band block: its id, its output record and point bucket;
+//  - per triangle: the block's vertices (key, position, gradient, votes: half a vertex per
+//    triangle, more on block borders), the weld's sort keys and remap, and the mesh.
+constexpr double kBytesPerGridBlock = 16;
+constexpr double kBytesPerBandBlock = 200;
+// Before any triangle is made: a low estimate (a block the surface crosses makes about B²
+// of them, and the band is at least twice as thick as the surface), so that the check
+// never refuses what would fit; the triangles themselves are then counted as they come.
+constexpr double kTrianglesPerBandBlock = B * B / 2.0;
+constexpr double kBytesPerTriangle = 160;
+
+double polygonize_memory(double grid_blocks, double band_blocks, double triangles) {
+    return grid_blocks * kBytesPerGridBlock + band_blocks * kBytesPerBandBlock + triangles * kBytesPerTriangle;
+}
+
+std::string resolution_text(int resolution) { return "polygonize at resolution " + std::to_string(resolution); }
 
 struct BlockOutput {
     std::vector<uint64_t> vertex_key;         // grid edge per vertex: corner id × 8 + direction
@@ -299,6 +319,9 @@ int default_resolution(const Octree &tree) {
 Mesh polygonize(const MpuFunction &mpu, const WindingField &winding, const PointSet &points,
                 const PointMeasures &measures, int resolution, const Params &params, Progress &progress) {
     const double h = 1.0 / resolution, min_trust = 2.0 * h;
+    // Before allocating anything: the grid alone, then with the band, must fit the budget.
+    const double grid_blocks = BlockGrid::blocks_for(points, resolution, std::max(measures.widest_trust, min_trust));
+    check_memory(polygonize_memory(grid_blocks, 0, 0), params.max_memory, resolution_text(resolution).c_str());
     const BlockGrid g(points, resolution, measures.trust_radius, min_trust, winding, progress);
     // A band block meets some point's reach, so each of its corners has a point within that
     // reach plus the block's diagonal: the bound for every neighbour search below.
@@ -307,6 +330,9 @@ Mesh polygonize(const MpuFunction &mpu, const WindingField &winding, const Point
     std::vector<int64_t> band;
     for (int64_t b = 0; b < int64_t(g.block_count()); ++b)
         if (g.band[size_t(b)]) band.push_back(b);
+    const double band_blocks = double(band.size());
+    check_memory(polygonize_memory(grid_blocks, band_blocks, band_blocks * kTrianglesPerBandBlock), params.max_memory,
+                 resolution_text(resolution).c_str());
     progress.report(0.02);
     progress.throw_if_cancelled();
 
@@ -318,11 +344,16 @@ Mesh polygonize(const MpuFunction &mpu, const WindingField &winding, const Point
     parallel_for(0, band.size(), resolve_threads(params.threads), progress, [&](size_t i) {
         polygonize_block(g, f, buckets, band, i, blocks[i]);
         const uint64_t made = blocks[i].triangles.size() / 3;
-        if (double(triangles.fetch_add(made) + made) > params.max_triangles)
+        const double so_far = double(triangles.fetch_add(made) + made);
+        if (so_far > params.max_triangles)
             throw Error(GMPU_ERROR_LIMIT_EXCEEDED,
                         "the mesh needs more than GMPU_PARAM_MAX_TRIANGLES = " +
                             std::to_string(uint64_t(params.max_triangles)) +
                             " triangles; lower GMPU_PARAM_RESOLUTION or raise the cap");
+        // Enforced as the triangles are made, not only estimated: the surface may be larger
+        // than the band suggested.
+        check_memory(polygonize_memory(grid_blocks, band_blocks, so_far), params.max_memory,
+                     resolution_text(resolution).c_str());
     }, 0.02 * total, total, 1);  // one block per chunk: a cancel waits for one block per thread
     progress.throw_if_cancelled();
     progress.report(0.95);

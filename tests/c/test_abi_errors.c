@@ -233,6 +233,8 @@ static void test_tiny_clouds(void **state) {
         if (st == GMPU_OK) {
             const char *problem = robust_mesh_problem(m);
             if (problem) fail_msg("%zu points: %s", sizes[k], problem);
+            /* An empty mesh is no success: it must be an error with a message. */
+            if (gmpu_mesh_triangle_count(m) == 0) fail_msg("%zu points: an empty mesh and GMPU_OK", sizes[k]);
         } else {
             assert_null(m);
             assert_true(strlen(gmpu_last_error()) > strlen(gmpu_status_name(st)) + 4);
@@ -412,6 +414,7 @@ static void test_parameters(void **state) {
         {GMPU_PARAM_MAX_CELLS, "GMPU_PARAM_MAX_CELLS", {0, 2e9, 10.5, NAN, -5, INFINITY}, 6, 1e6},
         {GMPU_PARAM_MAX_TRIANGLES, "GMPU_PARAM_MAX_TRIANGLES", {0, 3e9, 0.5, NAN, -5, INFINITY}, 6, 1e6},
         {GMPU_PARAM_NOISE_SCALE, "GMPU_PARAM_NOISE_SCALE", {-0.1, 20.5, NAN, INFINITY, 0, 0}, 4, 2},
+        {GMPU_PARAM_MAX_MEMORY, "GMPU_PARAM_MAX_MEMORY", {0, 999999, 2e15, NAN, -1, INFINITY}, 6, 5e9},
     };
     for (size_t c = 0; c < sizeof cases / sizeof *cases; ++c) {
         double before = -1, after = -1;
@@ -622,6 +625,232 @@ static void test_extreme_scales(void **state) {
     }
 }
 
+/* Calls on a surface from its own progress callback. Each would free or rebuild what the
+ * running stage reads (the points, the octree, the surface itself): they must be refused
+ * with GMPU_ERROR_BUSY, naming the running stage, and change nothing; destroy is deferred
+ * until the stage returns (cancelling it). A second surface stays usable from the callback. */
+enum reentry { RE_SET_POINTS, RE_SET_NORMALS, RE_SET_PARAM, RE_SET_PROGRESS, RE_FIT, RE_ORIENT, RE_POLYGONIZE,
+               RE_EVALUATE, RE_COPY_NORMALS, RE_GET_PARAM, RE_GET_STAT, RE_DESTROY, RE_OTHER_SURFACE, RE_COUNT };
+static const char *const kReentryNames[RE_COUNT] = {
+    "gmpu_surface_set_points", "gmpu_surface_set_normals", "gmpu_surface_set_param", "gmpu_surface_set_progress",
+    "gmpu_surface_fit", "gmpu_surface_orient", "gmpu_surface_polygonize", "gmpu_surface_evaluate",
+    "gmpu_surface_copy_normals", "gmpu_surface_get_param", "gmpu_surface_get_stat", "gmpu_surface_destroy",
+    "another surface"};
+
+struct reentry_probe {
+    gmpu_surface *s;
+    enum reentry what;
+    gmpu_stage during;
+    int calls;             /* callback calls during `during` that made the re-entrant call */
+    gmpu_status status;    /* of the first one */
+    char message[512];
+};
+
+static int reentering_progress(void *user, gmpu_stage stage, double fraction) {
+    (void)fraction;
+    struct reentry_probe *p = user;
+    if (stage != p->during || p->calls++ > 0) return 0;
+    gmpu_surface *s = p->s;
+    double v[6] = {0, 0, 0, 0, 0, 0}, n[3 * N_GOOD];
+    gmpu_mesh *m = NULL;
+    gmpu_status st = GMPU_OK;
+    for (size_t i = 0; i < 3 * N_GOOD; ++i) n[i] = g_good[i] - kCentre[i % 3];
+    switch (p->what) {
+        case RE_SET_POINTS: st = gmpu_surface_set_points_f64(s, g_good, 100, 0); break;
+        case RE_SET_NORMALS: st = gmpu_surface_set_normals_f64(s, n, N_GOOD, 0); break;
+        case RE_SET_PARAM: st = gmpu_surface_set_param(s, GMPU_PARAM_ERROR, 0.01); break;
+        case RE_SET_PROGRESS: st = gmpu_surface_set_progress(s, NULL, NULL); break;
+        case RE_FIT: st = gmpu_surface_fit(s); break;
+        case RE_ORIENT: st = gmpu_surface_orient(s); break;
+        case RE_POLYGONIZE: st = gmpu_surface_polygonize(s, &m); break;
+        case RE_EVALUATE: st = gmpu_surface_evaluate(s, kCentre, 1, v, NULL); break;
+        case RE_COPY_NORMALS: st = gmpu_surface_copy_normals(s, n, N_GOOD); break;
+        case RE_GET_PARAM: st = gmpu_surface_get_param(s, GMPU_PARAM_ERROR, v); break;
+        case RE_GET_STAT: st = gmpu_surface_get_stat(s, GMPU_STAT_CELLS, v); break;
+        case RE_DESTROY: gmpu_surface_destroy(s); break;
+        case RE_OTHER_SURFACE: {
+            gmpu_surface *other = NULL;
+            st = gmpu_surface_create(&other);
+            if (st == GMPU_OK) st = gmpu_surface_set_param(other, GMPU_PARAM_RESOLUTION, 24);
+            gmpu_mesh *om = st == GMPU_OK ? robust_reconstruct(other, g_good, N_GOOD) : NULL;
+            if (!om) st = GMPU_ERROR_INTERNAL;
+            gmpu_mesh_destroy(om);
+            gmpu_surface_destroy(other);
+            break;
+        }
+        case RE_COUNT: break;
+    }
+    gmpu_mesh_destroy(m);
+    p->status = st;
+    snprintf(p->message, sizeof p->message, "%s", gmpu_last_error());
+    return 0;
+}
+
+static void test_reentrant_calls_refused(void **state) {
+    (void)state;
+    static const char *const stage_names[4] = {"", "gmpu_surface_fit", "gmpu_surface_orient",
+                                               "gmpu_surface_polygonize"};
+    for (int during = GMPU_STAGE_FIT; during <= GMPU_STAGE_POLYGONIZE; ++during)
+        for (int what = 0; what < RE_COUNT; ++what) {
+            struct reentry_probe p = {NULL, (enum reentry)what, (gmpu_stage)during, 0, GMPU_OK, ""};
+            gmpu_surface *s = new_surface();
+            p.s = s;
+            /* Oriented already, so that evaluate and copy_normals would otherwise succeed. */
+            gmpu_mesh *first = robust_reconstruct(s, g_good, N_GOOD);
+            gmpu_mesh_destroy(first);
+            double cells_before = 0, cells_after = 0;
+            assert_ok(gmpu_surface_get_stat(s, GMPU_STAT_CELLS, &cells_before));
+            assert_ok(gmpu_surface_set_progress(s, reentering_progress, &p));
+            gmpu_mesh *m = NULL;
+            gmpu_status st = during == GMPU_STAGE_FIT      ? gmpu_surface_fit(s)
+                             : during == GMPU_STAGE_ORIENT ? gmpu_surface_orient(s)
+                                                           : gmpu_surface_polygonize(s, &m);
+            if (p.calls == 0) fail_msg("%s: the callback never ran", stage_names[during]);
+            if (what == RE_DESTROY) {
+                /* Deferred: the surface is gone once the stage returns, which it cancelled. */
+                if (st != GMPU_ERROR_CANCELLED && st != GMPU_OK)
+                    fail_msg("destroy during %s: the stage returned %s", stage_names[during], gmpu_status_name(st));
+                gmpu_mesh_destroy(m);
+                continue;
+            }
+            if (what == RE_OTHER_SURFACE) {
+                if (p.status != GMPU_OK) fail_msg("another surface during %s: %s", stage_names[during], p.message);
+            } else {
+                if (p.status != GMPU_ERROR_BUSY || !strstr(p.message, "GMPU_ERROR_BUSY") ||
+                    !strstr(p.message, kReentryNames[what]) || !strstr(p.message, stage_names[during]))
+                    fail_msg("%s during %s: %s, \"%s\"", kReentryNames[what], stage_names[during],
+                             gmpu_status_name(p.status), p.message);
+            }
+            if (st != GMPU_OK) fail_msg("%s after a refused %s: %s", stage_names[during], kReentryNames[what], gmpu_last_error());
+            /* Nothing changed underneath the stage: same points, same parameters. */
+            assert_int_equal(gmpu_surface_point_count(s), N_GOOD);
+            double e = 0;
+            assert_ok(gmpu_surface_get_param(s, GMPU_PARAM_ERROR, &e));
+            assert_true(e == 0.002);
+            assert_ok(gmpu_surface_get_stat(s, GMPU_STAT_CELLS, &cells_after));
+            assert_true(cells_after == cells_before);
+            if (m) {
+                const char *problem = robust_mesh_problem(m);
+                if (problem) fail_msg("mesh of the polygonize with a refused call: %s", problem);
+            }
+            gmpu_mesh_destroy(m);
+            assert_ok(gmpu_surface_set_progress(s, NULL, NULL));
+            check_usable_and_destroy(s);
+        }
+    assert_string_equal(gmpu_status_name(GMPU_ERROR_BUSY), "GMPU_ERROR_BUSY");
+    assert_int_equal(GMPU_ERROR_BUSY, 12);
+}
+
+/* A few points far from the rest (a scanner's stray returns, a wrong line in a file) must not
+ * set the scale: with two of them at ±100 to ±1e6 sphere radii, the sphere is still meshed
+ * as without them (they used to leave it smaller than one grid cube: an empty mesh and
+ * GMPU_OK, or a blob around the outliers, or "collinear"). They are counted in
+ * GMPU_STAT_OUTLIERS, still count as input points, and get the nearest point's normal. */
+static void test_outliers_set_aside(void **state) {
+    (void)state;
+    const size_t n = N_GOOD + 2;
+    double *xyz = malloc(3 * n * sizeof *xyz), *normals = malloc(3 * n * sizeof *normals);
+    memcpy(xyz, g_good, 3 * N_GOOD * sizeof *xyz);
+    gmpu_surface *clean = new_surface();
+    gmpu_mesh *reference = robust_reconstruct(clean, g_good, N_GOOD);
+    double clean_outliers = -1, clean_diag = 0;
+    assert_ok(gmpu_surface_get_stat(clean, GMPU_STAT_OUTLIERS, &clean_outliers));
+    assert_ok(gmpu_surface_get_stat(clean, GMPU_STAT_BBOX_DIAGONAL, &clean_diag));
+    assert_true(clean_outliers == 0);
+    const double offsets[] = {100, 1000, 1e4, 1e6};
+    for (size_t k = 0; k < sizeof offsets / sizeof *offsets; ++k) {
+        for (int d = 0; d < 3; ++d) {
+            xyz[3 * N_GOOD + d] = kCentre[d] + offsets[k];
+            xyz[3 * N_GOOD + 3 + d] = kCentre[d] - offsets[k] * (d == 1 ? 0.5 : 1.0);
+        }
+        gmpu_surface *s = new_surface();
+        gmpu_mesh *m = robust_reconstruct(s, xyz, n);
+        double outliers = 0, points = 0, diag = 0;
+        assert_ok(gmpu_surface_get_stat(s, GMPU_STAT_OUTLIERS, &outliers));
+        assert_ok(gmpu_surface_get_stat(s, GMPU_STAT_POINTS, &points));
+        assert_ok(gmpu_surface_get_stat(s, GMPU_STAT_BBOX_DIAGONAL, &diag));
+        if (outliers != 2) fail_msg("outliers at %g: %g found", offsets[k], outliers);
+        assert_true(points == (double)n && gmpu_surface_point_count(s) == n);
+        assert_true(diag == clean_diag); /* the scale is the sphere's */
+        /* The same mesh as without the outliers. */
+        assert_int_equal(gmpu_mesh_triangle_count(m), gmpu_mesh_triangle_count(reference));
+        assert_memory_equal(gmpu_mesh_vertices(m), gmpu_mesh_vertices(reference),
+                            3 * gmpu_mesh_vertex_count(m) * sizeof(double));
+        /* Normals for every input point, the outliers included (unit length). */
+        assert_ok(gmpu_surface_copy_normals(s, normals, n));
+        for (size_t i = N_GOOD; i < n; ++i) {
+            const double *v = normals + 3 * i;
+            assert_true(fabs(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] - 1) < 1e-6);
+        }
+        /* Input normals count the outliers too. */
+        assert_ok(gmpu_surface_set_normals_f64(s, normals, n, 0));
+        check_failure(gmpu_surface_set_normals_f64(s, normals, N_GOOD, 0), GMPU_ERROR_INVALID_INPUT, "2002 points");
+        gmpu_mesh_destroy(m);
+        gmpu_surface_destroy(s);
+    }
+    gmpu_mesh_destroy(reference);
+    gmpu_surface_destroy(clean);
+
+    /* Two clusters a million sizes apart: not "collinear", but a message saying what it is. */
+    for (size_t i = 0; i < N_GOOD; ++i)
+        for (int d = 0; d < 3; ++d) xyz[3 * i + d] = g_good[3 * i + d] + (i % 2 ? 1e6 : 0.0);
+    gmpu_surface *s = new_surface();
+    check_failure(gmpu_surface_set_points_f64(s, xyz, N_GOOD, 0), GMPU_ERROR_INVALID_INPUT, "clusters");
+    free(xyz);
+    free(normals);
+    check_usable_and_destroy(s);
+}
+
+/* Counts whose byte sizes overflow size_t are rejected before any read. */
+static void test_overflowing_counts(void **state) {
+    (void)state;
+    gmpu_surface *s = new_surface();
+    gmpu_mesh *first = robust_reconstruct(s, g_good, N_GOOD);
+    gmpu_mesh_destroy(first);
+    double q[3] = {0, 0, 0}, v[1] = {7}, g[3] = {7, 7, 7};
+    const size_t huge[] = {SIZE_MAX, SIZE_MAX / 3 + 1, SIZE_MAX / 24 + 1, ((size_t)1 << 62) + 1};
+    for (size_t k = 0; k < sizeof huge / sizeof *huge; ++k) {
+        check_failure(gmpu_surface_evaluate(s, q, huge[k], v, g), GMPU_ERROR_INVALID_ARGUMENT, "count");
+        assert_true(v[0] == 7 && g[0] == 7);
+        check_failure(gmpu_surface_set_points_f64(s, g_good, huge[k], 0), GMPU_ERROR_INVALID_ARGUMENT, "too many");
+        check_failure(gmpu_surface_set_points_f32(s, (const float *)g_good, huge[k], 0), GMPU_ERROR_INVALID_ARGUMENT,
+                      "too many");
+        check_failure(gmpu_surface_set_normals_f64(s, g_good, huge[k], 0), GMPU_ERROR_INVALID_ARGUMENT, "too many");
+        gmpu_mesh *m = NULL;
+        const uint32_t tri[3] = {0, 0, 0};
+        check_failure(gmpu_mesh_create(q, huge[k], tri, 1, &m), GMPU_ERROR_INVALID_ARGUMENT, "too large");
+        check_failure(gmpu_mesh_create(q, 1, tri, huge[k], &m), GMPU_ERROR_INVALID_ARGUMENT, "too large");
+        assert_null(m);
+    }
+    /* The stride times the count overflows, though each alone is modest. */
+    check_failure(gmpu_surface_set_points_f64(s, g_good, (size_t)1 << 40, (size_t)1 << 30), GMPU_ERROR_INVALID_ARGUMENT,
+                  "too many");
+    check_usable_and_destroy(s);
+}
+
+/* Normals are directions: any finite, non-zero length is accepted, however tiny or huge. */
+static void test_normals_of_any_length(void **state) {
+    (void)state;
+    gmpu_surface *s = new_surface();
+    assert_ok(gmpu_surface_set_points_f64(s, g_good, N_GOOD, 0));
+    double *n = malloc(3 * N_GOOD * sizeof *n);
+    const double scales[] = {1e-320, 5e-324, 1e-160, 1e200, 1e300, DBL_MAX};
+    for (size_t k = 0; k < sizeof scales / sizeof *scales; ++k) {
+        for (size_t i = 0; i < 3 * N_GOOD; ++i) n[i] = (g_good[i] - kCentre[i % 3]) * scales[k];
+        if (scales[k] == DBL_MAX) /* the components themselves stay finite: clamp */
+            for (size_t i = 0; i < 3 * N_GOOD; ++i) n[i] = fmax(-DBL_MAX, fmin(DBL_MAX, n[i]));
+        if (gmpu_surface_set_normals_f64(s, n, N_GOOD, 0) != GMPU_OK)
+            fail_msg("normals scaled by %g: %s", scales[k], gmpu_last_error());
+        assert_ok(gmpu_surface_fit(s));
+        assert_ok(gmpu_surface_orient(s));
+        double f = 0;
+        assert_ok(gmpu_surface_evaluate(s, kCentre, 1, &f, NULL));
+        if (!(f > 0.5)) fail_msg("normals scaled by %g: f(centre) = %g", scales[k], f);
+    }
+    free(n);
+    check_usable_and_destroy(s);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_null_handles_and_buffers),
@@ -635,6 +864,10 @@ int main(void) {
         cmocka_unit_test(test_evaluate_and_normals_errors),
         cmocka_unit_test(test_error_messages),
         cmocka_unit_test(test_extreme_scales),
+        cmocka_unit_test(test_reentrant_calls_refused),
+        cmocka_unit_test(test_overflowing_counts),
+        cmocka_unit_test(test_normals_of_any_length),
+        cmocka_unit_test(test_outliers_set_aside),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

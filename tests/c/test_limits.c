@@ -1,7 +1,9 @@
 /* Resource caps through the C ABI: GMPU_PARAM_MAX_CELLS and GMPU_PARAM_MAX_TRIANGLES fail
  * cleanly with GMPU_ERROR_LIMIT_EXCEEDED exactly past the cap (the cap itself is allowed),
  * quickly, without keeping a partial result, and leave the handle usable;
- * GMPU_PARAM_MAX_DEPTH caps GMPU_STAT_DEPTH. */
+ * GMPU_PARAM_MAX_DEPTH caps GMPU_STAT_DEPTH; a process limit that refuses worker threads
+ * costs parallelism, never the process or the result; GMPU_PARAM_MAX_MEMORY refuses what
+ * would not fit the budget. */
 #define _GNU_SOURCE
 #include <setjmp.h>
 #include <stdarg.h>
@@ -14,6 +16,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "gmpu/gmpu.h"
 #include "robust_util.h"
@@ -218,12 +223,139 @@ static void test_memory_returned(void **state) {
         fail_msg("%.1f of %.1f MB still resident after destroy", (after - before) / 1e6, (alive - before) / 1e6);
 }
 
+/* The mesh of g_bumpy with `threads` workers (resolution 40). */
+static gmpu_mesh *bumpy_mesh(unsigned threads, gmpu_status *status) {
+    gmpu_surface *s = surface_with_points();
+    gmpu_mesh *m = NULL;
+    *status = gmpu_surface_set_param(s, GMPU_PARAM_THREADS, threads);
+    if (*status == GMPU_OK) *status = gmpu_surface_fit(s);
+    if (*status == GMPU_OK) *status = gmpu_surface_orient(s);
+    if (*status == GMPU_OK) *status = gmpu_surface_polygonize(s, &m);
+    gmpu_surface_destroy(s);
+    return m;
+}
+
+static int same_mesh(const gmpu_mesh *a, const gmpu_mesh *b) {
+    const size_t nv = gmpu_mesh_vertex_count(a), nt = gmpu_mesh_triangle_count(a);
+    return nv == gmpu_mesh_vertex_count(b) && nt == gmpu_mesh_triangle_count(b) &&
+           memcmp(gmpu_mesh_vertices(a), gmpu_mesh_vertices(b), 3 * nv * sizeof(double)) == 0 &&
+           memcmp(gmpu_mesh_triangles(a), gmpu_mesh_triangles(b), 3 * nt * sizeof(uint32_t)) == 0;
+}
+
+/* A process limit (a container's pids cap, `ulimit -u`) makes thread creation fail part way
+ * through a stage's pool. The stage must go on with the threads it got, join them, and give
+ * the same mesh as one thread; it used to terminate the process. Each limit runs in a forked
+ * child under RLIMIT_NPROC; root ignores that limit, so a root child first becomes nobody
+ * (which owns no other task here: a limit of k leaves room for k - 1 workers). */
+static void test_thread_creation_refused(void **state) {
+    (void)state;
+    gmpu_status status;
+    gmpu_mesh *reference = bumpy_mesh(1, &status);
+    assert_ok(status);
+    const rlim_t limits[] = {1, 2, 3, 5};
+    for (size_t k = 0; k < sizeof limits / sizeof *limits; ++k) {
+        fflush(NULL);
+        pid_t pid = fork();
+        assert_true(pid >= 0);
+        if (pid == 0) {
+            if (geteuid() == 0 && (setgid(65534) != 0 || setuid(65534) != 0)) _exit(10);
+            struct rlimit lim = {limits[k], limits[k]};
+            if (setrlimit(RLIMIT_NPROC, &lim) != 0) _exit(11);
+            gmpu_mesh *m = bumpy_mesh(16, &status);
+            int code = status != GMPU_OK ? 12 : same_mesh(m, reference) ? 0 : 13;
+            if (code) fprintf(stderr, "limit %d: %s\n", (int)limits[k], gmpu_last_error());
+            gmpu_mesh_destroy(m);
+            _exit(code); /* skips the leak checker's exit thread, which the limit refuses */
+        }
+        int wstatus = 0;
+        assert_true(waitpid(pid, &wstatus, 0) == pid);
+        if (WIFSIGNALED(wstatus))
+            fail_msg("RLIMIT_NPROC %d: the child died of signal %d", (int)limits[k], WTERMSIG(wstatus));
+        if (WEXITSTATUS(wstatus) != 0)
+            fail_msg("RLIMIT_NPROC %d: child exit %d (12: failed, 13: another mesh)", (int)limits[k],
+                     WEXITSTATUS(wstatus));
+    }
+    gmpu_mesh_destroy(reference);
+}
+
+/* GMPU_PARAM_MAX_MEMORY: half the physical memory by default; a stage whose estimated peak
+ * exceeds it fails with LIMIT_EXCEEDED naming the estimate and the budget, before it
+ * allocates what it cannot hold (a resolution of 4096 fails at once, instead of growing
+ * until the system kills the process), and keeps the surface usable. Whatever the budget, a
+ * stage either fails so or gives the mesh of an unlimited budget. */
+static void test_max_memory(void **state) {
+    (void)state;
+    gmpu_surface *s = surface_with_points();
+    double v = 0;
+    assert_ok(gmpu_surface_get_param(s, GMPU_PARAM_MAX_MEMORY, &v));
+    const double half = 0.5 * (double)sysconf(_SC_PHYS_PAGES) * (double)sysconf(_SC_PAGESIZE);
+    if (fabs(v - half) > 1) fail_msg("default GMPU_PARAM_MAX_MEMORY %g, half the physical memory %g", v, half);
+
+    gmpu_status status;
+    gmpu_mesh *reference = bumpy_mesh(0, &status);
+    assert_ok(status);
+
+    /* A budget too small for the points themselves: fit refuses at once. */
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_MAX_MEMORY, 1e6));
+    check_failure(gmpu_surface_fit(s), GMPU_ERROR_LIMIT_EXCEEDED, "GMPU_PARAM_MAX_MEMORY = 1e+06 bytes");
+    assert_non_null(strstr(gmpu_last_error(), "fit ("));
+
+    /* Fitted and oriented with room to spare, then a huge grid on a small budget: refused
+     * before the grid is allocated, in a fraction of a normal polygonize's time. */
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_MAX_MEMORY, v));
+    assert_ok(gmpu_surface_fit(s));
+    assert_ok(gmpu_surface_orient(s));
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_MAX_MEMORY, 2e8));
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_RESOLUTION, 4096));
+    gmpu_mesh *m = (gmpu_mesh *)&m;
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t0);
+    check_failure(gmpu_surface_polygonize(s, &m), GMPU_ERROR_LIMIT_EXCEEDED, "resolution 4096");
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t1);
+    assert_null(m);
+    assert_non_null(strstr(gmpu_last_error(), "GMPU_PARAM_MAX_MEMORY = 2e+08 bytes"));
+    const double cpu = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+    if (!robust_quick() && cpu > 0.5) fail_msg("the refused polygonize took %.3f s of CPU", cpu);
+
+    /* Budgets from tiny to ample: each stage fails cleanly or gives the same mesh. Both checks
+     * are met on the way: the one before the stage allocates, and the one as it goes. */
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_RESOLUTION, 40));
+    int refused = 0, fitted_ok = 0;
+    for (double budget = 1e6; budget <= 1e9; budget *= 1.5) {
+        assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_MAX_MEMORY, floor(budget)));
+        m = NULL;
+        status = gmpu_surface_fit(s);
+        if (status == GMPU_OK) fitted_ok = 1, status = gmpu_surface_orient(s);
+        if (status == GMPU_OK) status = gmpu_surface_polygonize(s, &m);
+        if (status == GMPU_OK) {
+            if (!same_mesh(m, reference)) fail_msg("budget %g: another mesh", budget);
+            gmpu_mesh_destroy(m);
+            break;
+        }
+        if (status != GMPU_ERROR_LIMIT_EXCEEDED || !strstr(gmpu_last_error(), "GMPU_PARAM_MAX_MEMORY"))
+            fail_msg("budget %g: %s", budget, gmpu_last_error());
+        assert_null(m);
+        ++refused;
+    }
+    assert_true(refused > 0 && fitted_ok);
+    /* Back to the default: the same handle meshes. */
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_MAX_MEMORY, v));
+    m = NULL;
+    assert_ok(gmpu_surface_polygonize(s, &m));
+    assert_true(same_mesh(m, reference));
+    gmpu_mesh_destroy(m);
+    gmpu_mesh_destroy(reference);
+    gmpu_surface_destroy(s);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_max_cells),
         cmocka_unit_test(test_max_triangles),
         cmocka_unit_test(test_max_depth),
         cmocka_unit_test(test_memory_returned),
+        cmocka_unit_test(test_thread_creation_refused),
+        cmocka_unit_test(test_max_memory),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -18,6 +18,7 @@
 #include "fit/build_octree.hpp"
 #include "fit/fits.hpp"
 #include "fit/noise_estimate.hpp"
+#include "geometry/outliers.hpp"
 #include "geometry/point_set.hpp"
 #include "implicit/mpu_function.hpp"
 #include "implicit/winding_field.hpp"
@@ -188,6 +189,42 @@ gmpu_status status_of(Fn &&fn, std::string *message = nullptr) {
         return e.status();
     }
     return GMPU_OK;
+}
+
+// Outliers are points far from all others against the cloud's own spacing: single strays
+// and a small far group are found at any distance, in float and double input; dense
+// clusters, a sparse but evenly sampled region, and clouds too small to judge are not.
+void outliers_are_far_from_everything(void **) {
+    std::vector<double> xyz = flat(sphere_points(2000, 1, 0, 1));
+    OutlierScan none = find_outliers(xyz.data(), 2000, 0, false);
+    assert_true(none.outliers.empty());
+    assert_true(none.spacing > 0.0 && std::fabs(none.extent - 2.0) < 0.01);
+    // Every 10th point of a second sphere 10 radii away: ten times sparser, still no outlier.
+    std::vector<double> sparse = flat(sphere_points(200, 1, 0, 2));
+    for (size_t i = 0; i < sparse.size(); i += 3) sparse[i] += 10.0;
+    std::vector<double> both = xyz;
+    both.insert(both.end(), sparse.begin(), sparse.end());
+    assert_true(find_outliers(both.data(), both.size() / 3, 0, false).outliers.empty());
+    for (double far : {30.0, 1e3, 1e8}) {
+        std::vector<double> with = xyz;
+        with.insert(with.end(), {far, 0.0, 0.0, -far, far, 0.5});                  // two strays
+        for (int k = 0; k < 3; ++k) with.insert(with.end(), {0.0, far + 0.01 * k, 0.0});  // a group of 3
+        OutlierScan scan = find_outliers(with.data(), with.size() / 3, 0);
+        assert_int_equal(scan.outliers.size(), 5);
+        for (size_t k = 0; k < 5; ++k) assert_int_equal(scan.outliers[k], 2000 + k);
+        assert_true(std::fabs(scan.extent - 2.0) < 0.01);  // the kept points' extent
+        std::vector<float> f(with.begin(), with.end());
+        assert_int_equal(find_outliers(f.data(), f.size() / 3, 0).outliers.size(), 5);
+    }
+    // Strided records, and too few points to judge.
+    std::vector<double> rec;
+    for (size_t i = 0; i < 2000; ++i) rec.insert(rec.end(), {xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2], NAN});
+    rec.insert(rec.end(), {1e4, 0, 0, NAN});
+    assert_int_equal(find_outliers(rec.data(), 2001, 4 * sizeof(double)).outliers.size(), 1);
+    // Without a box wider than the bulk of the points, the scan is skipped (spacing 0).
+    assert_true(find_outliers(xyz.data(), 2000, 0).spacing == 0.0);
+    std::vector<double> few = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1e6, 1e6, 1e6};
+    assert_true(find_outliers(few.data(), 5, 0).outliers.empty());
 }
 
 void point_set_validation(void **) {
@@ -499,6 +536,7 @@ int main(void) {
         cmocka_unit_test(noise_estimate_ignores_a_second_sheet),
         cmocka_unit_test(noise_estimate_ignores_sparse_detail),
         cmocka_unit_test(point_set_validation),
+        cmocka_unit_test(outliers_are_far_from_everything),
         cmocka_unit_test(point_set_normalises_and_searches),
         cmocka_unit_test(blend_finds_every_covering_leaf),
         cmocka_unit_test(winding_number_of_a_sampled_sphere),

@@ -187,6 +187,36 @@ def test_limits(small_cloud):
         assert len(s.polygonize(resolution=16).faces) > 100
 
 
+def test_memory_budget(small_cloud):
+    pts, _ = small_cloud
+    import os
+    half = os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE") // 2
+    with gmpu.Surface(pts) as s:
+        assert s.params["max_memory"] == half
+        s.set_params(max_memory=10**6)
+        with pytest.raises(gmpu.LimitExceededError, match="GMPU_PARAM_MAX_MEMORY = 1e[+]06 bytes"):
+            s.fit()
+        s.set_params(max_memory=half)
+        s.fit().orient()
+        s.set_params(max_memory=10**8)
+        with pytest.raises(gmpu.LimitExceededError, match="resolution 4096 needs about"):
+            s.polygonize(resolution=4096)
+        s.set_params(max_memory=half)
+        assert len(s.polygonize(resolution=16).faces) > 100
+
+
+def test_outliers_are_set_aside_and_counted(small_cloud):
+    pts, _ = small_cloud
+    far = np.vstack([pts, pts.mean(axis=0) + 1000 * np.ptp(pts, axis=0), pts.mean(axis=0) - 1000 * np.ptp(pts, axis=0)])
+    with gmpu.Surface(pts) as clean, gmpu.Surface(far) as s:
+        assert clean.stats["outliers"] == 0
+        mesh_clean = clean.fit().orient().polygonize(resolution=32)
+        mesh = s.fit().orient().polygonize(resolution=32)
+        assert s.stats["outliers"] == 2 and s.stats["points"] == len(far)
+        assert np.array_equal(mesh.vertices, mesh_clean.vertices)
+        assert s.normals.shape == (len(far), 3)
+
+
 def test_file_errors(tmp_path):
     with pytest.raises(gmpu.IoError, match="GMPU_ERROR_IO") as e:
         gmpu.read_points(tmp_path / "missing.ply")

@@ -154,3 +154,48 @@ def test_stage_from_a_worker_thread_has_no_callback_but_works(small_cloud):
     th.join()
     assert len(out["mesh"].faces) > 0
     assert calls and set(calls) == {th.ident}  # the library calls back on the calling thread
+
+
+def test_refused_worker_threads_cost_speed_not_the_interpreter():
+    """Under a process limit that refuses most worker threads (a container's pids cap,
+    `ulimit -u`), reconstruct(threads=16) used to kill the interpreter (std::terminate); it
+    must give the mesh of threads=1. Root ignores RLIMIT_NPROC, so a root run drops to nobody
+    in the child first (which owns no other task: a limit of 3 leaves room for 2 threads)."""
+    import hashlib
+    import os
+    import resource
+    import subprocess
+    import sys
+
+    import pytest
+    from conftest import BINDINGS
+
+    rng = np.random.default_rng(3)
+    pts = rng.normal(size=(4000, 3))
+    pts /= np.linalg.norm(pts, axis=1)[:, None]
+    pts[:, 0] *= 1.0 + 0.3 * np.sin(4 * pts[:, 2])
+    mesh = gmpu.reconstruct(pts, threads=1, resolution=32)
+    expected = hashlib.sha256(mesh.vertices.tobytes() + mesh.faces.tobytes()).hexdigest()
+    script = (
+        "import hashlib, sys, numpy as np, gmpu\n"
+        "pts = np.frombuffer(sys.stdin.buffer.read(), dtype=np.float64).reshape(-1, 3)\n"
+        "m = gmpu.reconstruct(pts, threads=16, resolution=32)\n"
+        "print(hashlib.sha256(m.vertices.tobytes() + m.faces.tobytes()).hexdigest())\n")
+
+    def limit(nproc):
+        def apply():
+            if os.geteuid() == 0:
+                os.setgid(65534)
+                os.setuid(65534)
+            resource.setrlimit(resource.RLIMIT_NPROC, (nproc, nproc))
+        return apply
+
+    env = dict(os.environ, PYTHONPATH=str(BINDINGS), OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
+    for nproc in (1, 3):
+        try:
+            run = subprocess.run([sys.executable, "-c", script], env=env, preexec_fn=limit(nproc),
+                                 input=pts.tobytes(), capture_output=True, timeout=300)
+        except PermissionError:  # pragma: no cover - a sandbox that forbids setuid
+            pytest.skip("cannot drop privileges for the process limit")
+        assert run.returncode == 0, f"RLIMIT_NPROC {nproc}: exit {run.returncode}: {run.stderr[-2000:]!r}"
+        assert run.stdout.decode().strip() == expected, f"RLIMIT_NPROC {nproc}: another mesh"

@@ -17,7 +17,7 @@ The shared library is found through $GMPU_LIBRARY, then next to the installed pa
 then the source tree's meson build directory (see gmpu._library).
 """
 from ._library import LibraryNotFoundError, library_path, library_version, lib as _lib
-from ._errors import (CancelledError, DegenerateInputError, Error, InternalError, InvalidArgumentError,
+from ._errors import (BusyError, CancelledError, DegenerateInputError, Error, InternalError, InvalidArgumentError,
                       InvalidInputError, IoError, LimitExceededError, OutOfMemoryError, ParseError,
                       UnsupportedError, WrongOrderError)
 from ._progress import ProgressFn, Stage
@@ -31,5 +31,5 @@ __all__ = [
     "reconstruct", "Surface", "Mesh", "Points", "read_points", "Stage", "ProgressFn", "PARAMS", "STATS",
     "Error", "InvalidArgumentError", "InvalidInputError", "DegenerateInputError", "WrongOrderError",
     "OutOfMemoryError", "LimitExceededError", "CancelledError", "IoError", "ParseError", "UnsupportedError",
-    "InternalError", "LibraryNotFoundError", "library_path", "library_version", "abi_version", "__version__",
+    "InternalError", "BusyError", "LibraryNotFoundError", "library_path", "library_version", "abi_version", "__version__",
 ]

@@ -33,7 +33,8 @@ STATS: Dict[str, int] = _enum_names("gmpu_stat", "GMPU_STAT_")
 
 _EVAL_CHUNK = 1 << 16  # query points per gmpu_surface_evaluate call
 
-_INT_PARAMS = {"max_depth", "min_points", "resolution", "level", "threads", "max_cells", "max_triangles"}
+_INT_PARAMS = {"max_depth", "min_points", "resolution", "level", "threads", "max_cells", "max_triangles",
+               "max_memory"}
 _BOOL_PARAMS = {"sharp_features"}
 _FLOAT_STATS = {"fit_seconds", "orient_seconds", "polygonize_seconds", "bbox_diagonal", "noise",
                 "effective_error"}
@@ -297,7 +298,7 @@ class Surface:
 
     Parameters are the C library's (see ``gmpu.PARAMS``): error, max_depth, min_points,
     support_scale, sharp_features, resolution, level, threads, max_cells, max_triangles,
-    noise_scale; None keeps the library default.
+    noise_scale, max_memory; None keeps the library default.
 
     The C handle is freed by :meth:`close` (or leaving the ``with`` block); the garbage
     collector frees it otherwise. Methods are thread-safe: evaluate, gradient, normals,

@@ -51,7 +51,7 @@ class OutOfMemoryError(Error, MemoryError):
 
 
 class LimitExceededError(Error, RuntimeError):
-    """GMPU_ERROR_LIMIT_EXCEEDED: the max_cells or max_triangles cap was hit."""
+    """GMPU_ERROR_LIMIT_EXCEEDED: the max_cells, max_triangles or max_memory cap was hit."""
 
 
 class CancelledError(Error):
@@ -75,6 +75,11 @@ class InternalError(Error, RuntimeError):
     """GMPU_ERROR_INTERNAL: a bug in gmpu; please report it with the message."""
 
 
+class BusyError(Error, RuntimeError):
+    """GMPU_ERROR_BUSY: a call on a surface from its own progress callback (this package
+    raises RuntimeError before the call reaches the library)."""
+
+
 #: C status name → exception class. A status the library gains later maps to Error itself.
 ERROR_CLASSES: Dict[str, Type[Error]] = {
     "GMPU_ERROR_INVALID_ARGUMENT": InvalidArgumentError,
@@ -88,6 +93,7 @@ ERROR_CLASSES: Dict[str, Type[Error]] = {
     "GMPU_ERROR_PARSE": ParseError,
     "GMPU_ERROR_UNSUPPORTED": UnsupportedError,
     "GMPU_ERROR_INTERNAL": InternalError,
+    "GMPU_ERROR_BUSY": BusyError,
 }
 
 

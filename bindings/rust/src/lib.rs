@@ -94,7 +94,8 @@ pub enum Status {
     WrongOrder,
     /// `GMPU_ERROR_OUT_OF_MEMORY`.
     OutOfMemory,
-    /// `GMPU_ERROR_LIMIT_EXCEEDED`: [`Param::MaxCells`] or [`Param::MaxTriangles`] was hit.
+    /// `GMPU_ERROR_LIMIT_EXCEEDED`: [`Param::MaxCells`], [`Param::MaxTriangles`] or
+    /// [`Param::MaxMemory`] was hit.
     LimitExceeded,
     /// `GMPU_ERROR_CANCELLED`: the progress callback asked to stop.
     Cancelled,
@@ -106,13 +107,15 @@ pub enum Status {
     Unsupported,
     /// `GMPU_ERROR_INTERNAL`: a bug in gmpu.
     Internal,
+    /// `GMPU_ERROR_BUSY`: a call on a surface from its own progress callback.
+    Busy,
     /// A status this binding does not know (from a newer library).
     Unknown(u32),
 }
 
 impl Status {
     /// Every known status, in the header's order.
-    pub const ALL: [Status; 11] = [
+    pub const ALL: [Status; 12] = [
         Status::InvalidArgument,
         Status::InvalidInput,
         Status::DegenerateInput,
@@ -124,6 +127,7 @@ impl Status {
         Status::Parse,
         Status::Unsupported,
         Status::Internal,
+        Status::Busy,
     ];
 
     /// The status of a raw `gmpu_status`; `None` for `GMPU_OK`.
@@ -142,6 +146,7 @@ impl Status {
             GMPU_ERROR_PARSE => Status::Parse,
             GMPU_ERROR_UNSUPPORTED => Status::Unsupported,
             GMPU_ERROR_INTERNAL => Status::Internal,
+            GMPU_ERROR_BUSY => Status::Busy,
             other => Status::Unknown(other),
         })
     }
@@ -161,6 +166,7 @@ impl Status {
             Status::Parse => GMPU_ERROR_PARSE,
             Status::Unsupported => GMPU_ERROR_UNSUPPORTED,
             Status::Internal => GMPU_ERROR_INTERNAL,
+            Status::Busy => GMPU_ERROR_BUSY,
             Status::Unknown(raw) => raw,
         }
     }
@@ -288,6 +294,9 @@ key_enum! {
         MaxTriangles = sys::GMPU_PARAM_MAX_TRIANGLES,
         /// Noise floor for ε: fit works to max(Error, NoiseScale × estimated noise).
         NoiseScale = sys::GMPU_PARAM_NOISE_SCALE,
+        /// Memory budget in bytes: fit and polygonize fail with [`Status::LimitExceeded`]
+        /// when their estimated peak exceeds it. Default: half the physical memory.
+        MaxMemory = sys::GMPU_PARAM_MAX_MEMORY,
     }
 }
 
@@ -326,6 +335,8 @@ key_enum! {
         Noise = sys::GMPU_STAT_NOISE,
         /// The ε fit worked to, as a fraction of the diagonal.
         EffectiveError = sys::GMPU_STAT_EFFECTIVE_ERROR,
+        /// Input points set aside as outliers (far from every other point).
+        Outliers = sys::GMPU_STAT_OUTLIERS,
     }
 }
 

@@ -72,9 +72,9 @@ macro_rules! c_functions {
 
 /// `#define`d integer constants of the header.
 pub const GMPU_VERSION_MAJOR: u32 = 0;
-pub const GMPU_VERSION_MINOR: u32 = 1;
+pub const GMPU_VERSION_MINOR: u32 = 2;
 pub const GMPU_VERSION_PATCH: u32 = 0;
-pub const GMPU_VERSION_NUMBER: u32 = 100;
+pub const GMPU_VERSION_NUMBER: u32 = 200;
 pub const GMPU_ABI_VERSION: u32 = 1;
 pub const DEFINES: &[(&str, u32)] = &[
     ("GMPU_VERSION_MAJOR", GMPU_VERSION_MAJOR),
@@ -119,6 +119,7 @@ c_enums! {
         GMPU_ERROR_PARSE = 9,
         GMPU_ERROR_UNSUPPORTED = 10,
         GMPU_ERROR_INTERNAL = 11,
+        GMPU_ERROR_BUSY = 12,
     }
     gmpu_param {
         GMPU_PARAM_ERROR = 1,
@@ -132,6 +133,7 @@ c_enums! {
         GMPU_PARAM_MAX_CELLS = 9,
         GMPU_PARAM_MAX_TRIANGLES = 10,
         GMPU_PARAM_NOISE_SCALE = 11,
+        GMPU_PARAM_MAX_MEMORY = 12,
     }
     gmpu_stage {
         GMPU_STAGE_FIT = 1,
@@ -155,6 +157,7 @@ c_enums! {
         GMPU_STAT_BBOX_DIAGONAL = 14,
         GMPU_STAT_NOISE = 15,
         GMPU_STAT_EFFECTIVE_ERROR = 16,
+        GMPU_STAT_OUTLIERS = 17,
     }
 }
 
