@@ -185,7 +185,7 @@ typedef enum gmpu_stat {
 
 /* Progress and cancellation. Called on the thread that called fit / orient / polygonize,
  * at least every 50 ms of that thread's CPU time (from the call to its return, so a machine
- * busy with other work stretches the wall-clock interval) and at most every 20 ms, with
+ * busy with other work stretches the wall-clock interval) and at most every 10 ms, with
  * fraction in [0, 1] (non-decreasing within a stage; 1 when the stage completes). Return 0
  * to go on; non-zero cancels: the call stops within 100 ms of work (CPU time of all its
  * threads) and returns GMPU_ERROR_CANCELLED, and the surface keeps the stages completed

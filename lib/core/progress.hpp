@@ -19,7 +19,7 @@
 namespace gmpu {
 
 // The cadence gmpu.h documents (tests/c/test_docs_match.cpp checks the header's figures).
-constexpr auto kReportInterval = std::chrono::milliseconds(20);        // at most this often
+constexpr auto kReportInterval = std::chrono::milliseconds(10);        // at most this often
 constexpr auto kMaxWorkBetweenReports = std::chrono::milliseconds(50);  // at least this often
 constexpr auto kMaxCancelLatency = std::chrono::milliseconds(100);
 

@@ -166,6 +166,9 @@ struct Builder {
         check_fit_memory(n, 1, params.max_memory);
         tree.order.resize(n);
         std::iota(tree.order.begin(), tree.order.end(), 0u);
+        // Room for the cells up front (address space only until used): growing the array by
+        // doubling would copy all the cells made so far in one go, with no report between.
+        tree.cells.reserve(size_t(std::min(params.max_cells, 8.0 * double(n) / params.min_points + 64.0)));
 
         Cell root;
         root.centre.setZero();
@@ -201,6 +204,7 @@ struct Builder {
 
             std::vector<uint32_t> next;
             for (size_t i = 0; i < level.size(); ++i) {
+                progress.tick();
                 uint32_t parent = level[i];
                 if (kids[i].empty()) {  // stays a leaf, although its fit misses ε
                     Cell &stranded = tree.cells[parent];

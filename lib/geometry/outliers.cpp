@@ -6,6 +6,8 @@
 
 #include <nanoflann.hpp>
 
+#include "geometry/counting_result_set.hpp"
+
 namespace gmpu {
 
 namespace {
@@ -19,22 +21,6 @@ struct DoubleCloud {
 };
 using DoubleTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, DoubleCloud>,
                                                        DoubleCloud, 3, uint32_t>;
-
-// Whether at least `enough` points lie within the radius: stops searching once they do.
-struct EnoughWithin {
-    double radius_sq;
-    size_t enough;
-    size_t count = 0;
-    void init() {}
-    void clear() { count = 0; }
-    size_t size() const { return count; }
-    bool full() const { return true; }
-    bool addPoint(double dist, uint32_t) {
-        if (dist < radius_sq) ++count;
-        return count < enough;
-    }
-    double worstDist() const { return radius_sq; }
-};
 
 // Whether, on some axis, the bounding box is over kBulkFactor times as wide as the range
 // between the kBulkQuantile and 1 - kBulkQuantile quantiles of a sample: outliers that
@@ -114,7 +100,7 @@ OutlierScan find_outliers(const T *xyz, size_t count, size_t stride, bool only_i
 
     const double far_sq = kOutlierFar * kOutlierFar * spacing_sq;
     for (size_t i = 0; i < count; ++i) {
-        EnoughWithin near{far_sq, k + 1};
+        CountingResultSet<double> near{far_sq, k + 1};
         tree.findNeighbors(near, &cloud.xyz[3 * i], nanoflann::SearchParams(32, 0.0, false));
         if (near.count < k + 1) scan.outliers.push_back(uint32_t(i));
     }

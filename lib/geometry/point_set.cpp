@@ -9,6 +9,7 @@
 #include <nanoflann.hpp>
 
 #include "core/error.hpp"
+#include "geometry/counting_result_set.hpp"
 
 namespace gmpu {
 
@@ -29,22 +30,6 @@ struct CloudAdaptor {
 
 using KdTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<float, CloudAdaptor>,
                                                    CloudAdaptor, 3, uint32_t>;
-
-// Counts points inside a radius and stops the search once `enough` are seen.
-struct CountingResultSet {
-    float radius_sq;
-    size_t enough;
-    size_t count = 0;
-    void init() {}
-    void clear() { count = 0; }
-    size_t size() const { return count; }
-    bool full() const { return true; }
-    bool addPoint(float dist, uint32_t) {
-        if (dist < radius_sq) ++count;
-        return count < enough;
-    }
-    float worstDist() const { return radius_sq; }
-};
 
 // Appends indices of points inside a radius, without nanoflann's pair vector.
 struct CollectingResultSet {
@@ -218,7 +203,7 @@ void PointSet::within(const Eigen::Vector3d &c, double radius, std::vector<uint3
 
 size_t PointSet::count_within(const Eigen::Vector3d &c, double radius, size_t enough) const {
     const float q[3] = {float(c[0]), float(c[1]), float(c[2])};
-    CountingResultSet rs{float(radius * radius), enough};
+    CountingResultSet<float> rs{float(radius * radius), enough};
     index_->tree.findNeighbors(rs, q, nanoflann::SearchParams(32, 0.0f, false));
     return rs.count;
 }

@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/parallel.hpp"
+#include "core/resize_reporting.hpp"
 
 namespace gmpu {
 
@@ -89,8 +90,8 @@ double SurfaceField::value_among(const std::vector<uint32_t> &leaves, const Eige
 void measure_points(const Octree &tree, const PointSet &points, unsigned threads, Progress &progress,
                     PointMeasures &out) {
     const size_t n = points.size();
-    out.area.assign(n, 0.0f);
-    out.trust_radius.assign(n, 0.0f);
+    assign_reporting(out.area, n, progress);
+    assign_reporting(out.trust_radius, n, progress);
     auto set = [&](uint32_t i, double rk) {
         out.area[i] = float(M_PI * rk * rk / double(kNeighbours));
         out.trust_radius[i] = float(kTrustSpacings * rk);
@@ -110,6 +111,7 @@ void measure_points(const Octree &tree, const PointSet &points, unsigned threads
         // through the centre (π R² of area for its points), gives the k-th neighbour distance
         // sqrt(k · area per point / π) without a million neighbour searches.
         for (const Cell &c : tree.cells) {
+            progress.tick();
             if (!c.is_leaf() || c.point_end == c.point_begin) continue;
             const double area = M_PI * c.radius * c.radius / double(std::max<uint32_t>(1, c.support_count));
             const double rk = std::sqrt(double(kNeighbours) * area / M_PI);

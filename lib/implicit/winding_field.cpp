@@ -19,6 +19,8 @@ WindingField::WindingField(const Octree &tree, const PointSet &points, const std
         Moment &m = moments_[c];
         double total = 0.0;
         for (uint32_t k = cell.point_begin; k < cell.point_end; ++k) {
+            // The root and the coarse cells span most of the points: report within them.
+            if (progress && (k - cell.point_begin) % 8192 == 8191) progress->tick();
             double a = double(area[tree.order[k]]);
             m.centroid += a * points.point(tree.order[k]);
             m.dipole += weighted(tree.order[k]);

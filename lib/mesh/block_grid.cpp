@@ -76,10 +76,12 @@ void BlockGrid::sign_far_regions(const WindingField &winding, Progress &progress
         if (band[size_t(s)] || region[size_t(s)] >= 0) continue;
         // Block 0 is at the grid's corner, outside the band: region 0 is outside.
         const int32_t id = int32_t(region_sign.size());
+        progress.tick();  // a winding query per region
         region_sign.push_back(id > 0 && winding.winding(block_box(s).center()) > 0.5 ? 1 : -1);
         region[size_t(s)] = id;
         stack.push_back(s);
-        while (!stack.empty()) {
+        for (size_t filled = 1; !stack.empty(); ++filled) {
+            if (filled % 16384 == 0) progress.tick();  // the outside region spans most blocks
             const int64_t b = stack.back();
             stack.pop_back();
             int64_t pos[3];

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <numeric>
 
+#include "core/resize_reporting.hpp"
+
 namespace gmpu {
 
 namespace {
@@ -16,7 +18,8 @@ uint32_t find(std::vector<uint32_t> &parent, uint32_t x) {
 
 uint32_t vertex_components(const Mesh &mesh, std::vector<uint32_t> &component, Progress &progress) {
     const size_t n = mesh.vertex_count();
-    std::vector<uint32_t> parent(n);
+    std::vector<uint32_t> parent;
+    assign_reporting(parent, n, progress);
     std::iota(parent.begin(), parent.end(), 0u);
     for (size_t t = 0; t < mesh.triangles.size(); t += 3) {
         if (t % (3 * kTickEvery) == 0) progress.tick();
@@ -25,7 +28,7 @@ uint32_t vertex_components(const Mesh &mesh, std::vector<uint32_t> &component, P
             if (a != b) parent[std::max(a, b)] = std::min(a, b);
         }
     }
-    component.assign(n, UINT32_MAX);
+    assign_reporting(component, n, progress, UINT32_MAX);
     uint32_t count = 0;
     for (size_t v = 0; v < n; ++v) {
         if (v % kTickEvery == 0) progress.tick();

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "core/cancellable_sort.hpp"
+#include "core/resize_reporting.hpp"
 
 namespace gmpu {
 
@@ -12,7 +13,8 @@ PointBuckets::PointBuckets(const BlockGrid &g, const std::vector<int64_t> &band,
     const PointSet &points = f.points();
     // 1. Representatives: sort by voxel, keep the first (lowest index) of each.
     const double voxel = 0.5 * g.h;
-    std::vector<std::pair<uint64_t, uint32_t>> keyed(points.size());
+    std::vector<std::pair<uint64_t, uint32_t>> keyed;
+    assign_reporting(keyed, points.size(), progress);
     // Every loop over the points or the blocks runs on the calling thread: poll every few
     // thousand items (a million points take tens of milliseconds per loop).
     constexpr size_t kPollEvery = 4096;

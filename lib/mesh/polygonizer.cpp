@@ -263,7 +263,10 @@ Mesh weld(std::vector<BlockOutput> &blocks, const Normalisation &norm, Progress 
     mesh.triangles.reserve(triangle_slots);
     votes.reserve(welded);
     std::vector<std::vector<uint32_t>> remap(blocks.size());
-    for (size_t b = 0; b < blocks.size(); ++b) remap[b].resize(blocks[b].vertex_key.size());
+    for (size_t b = 0; b < blocks.size(); ++b) {
+        progress.poll(0.97);
+        remap[b].resize(blocks[b].vertex_key.size());
+    }
     for (size_t k = 0; k < keyed.size(); ++k) {
         if (k % 4096 == 0) progress.poll(0.97);
         const size_t b = keyed[k].second >> 32, v = keyed[k].second & 0xffffffffu;

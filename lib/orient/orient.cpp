@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/parallel.hpp"
+#include "core/resize_reporting.hpp"
 #include "orient/advancing_front.hpp"
 #include "orient/leaf_graph.hpp"
 #include "orient/outward.hpp"
@@ -92,7 +93,8 @@ OrientStats orient_octree(Octree &tree, const PointSet &points, const float *nor
 std::vector<float> point_normals(const MpuFunction &f, const PointSet &points, unsigned threads,
                                  Progress &progress, double done_before, double total) {
     const Octree &tree = f.tree();
-    std::vector<float> out(3 * points.size());
+    std::vector<float> out;
+    assign_reporting(out, 3 * points.size(), progress);
     std::vector<uint32_t> leaves;
     for (uint32_t i = 0; i < tree.cells.size(); ++i)
         if (tree.cells[i].is_leaf() && tree.cells[i].point_end > tree.cells[i].point_begin) leaves.push_back(i);
@@ -104,6 +106,8 @@ std::vector<float> point_normals(const MpuFunction &f, const PointSet &points, u
         f.gather(Eigen::AlignedBox3d(c.centre - half, c.centre + half), near);
         Eigen::Vector3d g;
         for (uint32_t k = c.point_begin; k < c.point_end; ++k) {
+            // A coarse leaf can hold thousands of points: report within it too.
+            if ((k - c.point_begin) % 16 == 15) progress.tick();
             uint32_t i = tree.order[k];
             Eigen::Vector3d p = points.point(i);
             f.value_among(near, p, &g);
@@ -115,7 +119,7 @@ std::vector<float> point_normals(const MpuFunction &f, const PointSet &points, u
             Eigen::Vector3d n = gn > 0.0 ? Eigen::Vector3d(-g / gn) : Eigen::Vector3d::UnitZ();
             for (int d = 0; d < 3; ++d) out[3 * i + d] = float(n[d]);
         }
-    }, done_before, total, 8);
+    }, done_before, total, 1);  // leaves come coarsest first: one per chunk
     progress.throw_if_cancelled();
     return out;
 }

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "core/cancellable_sort.hpp"
+#include "core/resize_reporting.hpp"
 #include "core/error.hpp"
 #include "core/parallel.hpp"
 #include "core/progress.hpp"
@@ -523,6 +524,22 @@ void cancellable_sort_sorts_and_cancels(void **) {
     assert_int_equal(calls, 1);
 }
 
+void assign_reporting_fills_and_cancels(void **) {
+    // Several megabyte slices and a partial last one, over a vector that held other values.
+    std::vector<uint32_t> v(10, 7);
+    Progress quiet(nullptr, nullptr, GMPU_STAGE_POLYGONIZE);
+    assign_reporting(v, 1000003, quiet, 42u);
+    assert_int_equal(v.size(), 1000003);
+    assert_true(std::all_of(v.begin(), v.end(), [](uint32_t x) { return x == 42u; }));
+    int calls = 0;
+    Progress cancelling([](void *user, gmpu_stage, double) -> int { return ++*static_cast<int *>(user) >= 1; }, &calls,
+                        GMPU_STAGE_POLYGONIZE);
+    cancelling.report(0.1, true);
+    std::vector<double> w;
+    assert_int_equal(status_of([&] { assign_reporting(w, 1u << 22, cancelling); }), GMPU_ERROR_CANCELLED);
+    assert_true(w.size() < size_t(1) << 22);
+}
+
 }  // namespace
 
 int main(void) {
@@ -548,6 +565,7 @@ int main(void) {
         cmocka_unit_test(parallel_for_runs_each_index_once),
         cmocka_unit_test(parallel_for_rethrows_and_cancels),
         cmocka_unit_test(cancellable_sort_sorts_and_cancels),
+        cmocka_unit_test(assign_reporting_fills_and_cancels),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
