@@ -4,6 +4,7 @@
  *
  *   gmpu-reconstruct INPUT -o OUTPUT [--normals-out POINTS.ply] [--error E]
  *                    [--max-depth D] [--resolution R] [--level L] [--threads T]
+ *                    [--noise-scale S] [--max-memory BYTES]
  *                    [--use-normals] [--sharp] [--quiet] [--version]
  *
  * Output format from the extension (.ply, .obj, .off). Exit status 0 on success, 1 on a
@@ -25,13 +26,14 @@
 
 typedef struct {
     const char *input, *output, *normals_out;
-    double error, max_depth, resolution, level, threads;
+    double error, max_depth, resolution, level, threads, noise_scale, max_memory;
     int use_normals, sharp, quiet;
 } options;
 
 static const char *usage =
     "usage: gmpu-reconstruct INPUT -o OUTPUT [--normals-out POINTS.ply] [--error E]\n"
     "                        [--max-depth D] [--resolution R] [--level L] [--threads T]\n"
+    "                        [--noise-scale S] [--max-memory BYTES]\n"
     "                        [--use-normals] [--sharp] [--quiet] [--version]\n"
     "  INPUT   .ply .xyz .txt .off .obj point cloud (normals ignored unless --use-normals)\n"
     "  OUTPUT  .ply .obj .off mesh (closed, outward-facing)\n"
@@ -62,7 +64,7 @@ static int parse_path(const char *flag, const char *text, const char **out) {
 }
 
 enum { OPT_NORMALS_OUT = 256, OPT_ERROR, OPT_MAX_DEPTH, OPT_RESOLUTION, OPT_LEVEL, OPT_THREADS, OPT_USE_NORMALS,
-       OPT_SHARP };
+       OPT_SHARP, OPT_NOISE_SCALE, OPT_MAX_MEMORY };
 
 static const struct option long_options[] = {
     {"output", required_argument, NULL, 'o'},
@@ -72,6 +74,8 @@ static const struct option long_options[] = {
     {"resolution", required_argument, NULL, OPT_RESOLUTION},
     {"level", required_argument, NULL, OPT_LEVEL},
     {"threads", required_argument, NULL, OPT_THREADS},
+    {"noise-scale", required_argument, NULL, OPT_NOISE_SCALE},
+    {"max-memory", required_argument, NULL, OPT_MAX_MEMORY},
     {"use-normals", no_argument, NULL, OPT_USE_NORMALS},
     {"sharp", no_argument, NULL, OPT_SHARP},
     {"quiet", no_argument, NULL, 'q'},
@@ -92,7 +96,7 @@ static int positional(options *o, const char *a) {
 static int parse_args(int argc, char **argv, options *o) {
     memset(o, 0, sizeof *o);
     /* NAN: not given (a negative value is given, and must reach the library's range check). */
-    o->error = o->max_depth = o->resolution = o->level = o->threads = NAN;
+    o->error = o->max_depth = o->resolution = o->level = o->threads = o->noise_scale = o->max_memory = NAN;
     opterr = 0; /* our own messages, one line each */
     optind = 1;
     /* "-": non-options come back in order (code 1), whatever POSIXLY_CORRECT says; ":": a
@@ -123,6 +127,8 @@ static int parse_args(int argc, char **argv, options *o) {
             case OPT_RESOLUTION: if (!parse_number(flag, optarg, &o->resolution)) return 0; break;
             case OPT_LEVEL: if (!parse_number(flag, optarg, &o->level)) return 0; break;
             case OPT_THREADS: if (!parse_number(flag, optarg, &o->threads)) return 0; break;
+            case OPT_NOISE_SCALE: if (!parse_number(flag, optarg, &o->noise_scale)) return 0; break;
+            case OPT_MAX_MEMORY: if (!parse_number(flag, optarg, &o->max_memory)) return 0; break;
             case OPT_USE_NORMALS: o->use_normals = 1; break;
             case OPT_SHARP: o->sharp = 1; break;
             case 'q': o->quiet = 1; break;
@@ -285,7 +291,8 @@ int main(int argc, char **argv) {
     if (gmpu_surface_create(&surface) != GMPU_OK) { rc = fail("cannot create surface"); goto done; }
     if (!set(surface, GMPU_PARAM_ERROR, o.error) || !set(surface, GMPU_PARAM_MAX_DEPTH, o.max_depth) ||
         !set(surface, GMPU_PARAM_RESOLUTION, o.resolution) || !set(surface, GMPU_PARAM_LEVEL, o.level) ||
-        !set(surface, GMPU_PARAM_THREADS, o.threads) ||
+        !set(surface, GMPU_PARAM_THREADS, o.threads) || !set(surface, GMPU_PARAM_NOISE_SCALE, o.noise_scale) ||
+        !set(surface, GMPU_PARAM_MAX_MEMORY, o.max_memory) ||
         !set(surface, GMPU_PARAM_SHARP_FEATURES, o.sharp ? 1.0 : NAN)) {
         rc = fail("bad parameter");
         goto done;

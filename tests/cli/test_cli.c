@@ -621,6 +621,20 @@ static void test_option_syntax(void **state) {
     const char *version[] = {"--version", NULL};
     r = run_cli(version);
     check_run(&r, 0, NULL);
+    /* The memory budget and the noise floor reach the library: a budget far too small fails
+     * cleanly with the library's message, an out-of-range noise scale is a bad parameter. */
+    const char *a5[] = {in, "-o", out, "--max-memory=1e6", "--quiet", NULL};
+    r = run_cli(a5);
+    check_run(&r, 1, "GMPU_PARAM_MAX_MEMORY");
+    assert_false(exists(out));
+    const char *a6[] = {in, "-o", out, "--noise-scale", "-1", "--quiet", NULL};
+    r = run_cli(a6);
+    check_run(&r, 1, "bad parameter");
+    const char *a7[] = {in, "-o", out, "--noise-scale=0", "--resolution=24", "--quiet", NULL};
+    r = run_cli(a7);
+    check_run(&r, 0, NULL);
+    check_off_sphere(out, c, 1.0, 0.05);
+    remove(out);
     assert_no_staging_left();
 }
 
