@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cstdint>
 #include <chrono>
 #include <cerrno>
 #include <cstdio>
@@ -76,8 +77,8 @@ AtomicFile::AtomicFile(std::string path) : path_(std::move(path)), target_(write
         }
         // Taken: a leftover of a killed process that had our pid, or of an earlier write
         // in this one. Leftovers come in runs of consecutive numbers, so jump well away.
-        n = temp_counter.fetch_add(1) +
-            static_cast<unsigned>(std::chrono::steady_clock::now().time_since_epoch().count() * 2654435761u);
+        const auto ticks = static_cast<uint64_t>(std::chrono::steady_clock::now().time_since_epoch().count());
+        n = temp_counter.fetch_add(1) + static_cast<unsigned>(ticks * 2654435761u);  // unsigned: wraps
     }
     if (fd_ < 0) {
         temp_.clear();
