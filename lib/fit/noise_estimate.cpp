@@ -6,6 +6,7 @@
 
 #include <Eigen/Cholesky>
 
+#include "core/two_groups.hpp"
 #include "fit/fits.hpp"
 
 namespace gmpu {
@@ -89,30 +90,17 @@ double unbiased_rms(const std::vector<double> &residuals, size_t count) {
     return std::sqrt(sum / double(count - 6));
 }
 
-// The best split of residuals[0, count) into two groups (1D two-means): the threshold
-// between them and how many pooled standard deviations apart their means are.
+// The best split of residuals[0, count) into two groups: the threshold between them and
+// how many pooled standard deviations apart their means are.
 double two_means(const std::vector<double> &residuals, size_t count, double &separation) {
     std::vector<double> s(residuals.begin(), residuals.begin() + long(count));
     std::sort(s.begin(), s.end());
-    std::vector<double> sum(count + 1, 0.0), sq(count + 1, 0.0);
-    for (size_t i = 0; i < count; ++i) {
-        sum[i + 1] = sum[i] + s[i];
-        sq[i + 1] = sq[i] + s[i] * s[i];
-    }
-    double best = INFINITY, threshold = 0.0;
+    const TwoGroups t = split_two_groups(s, kSheetMinSide);
     separation = 0.0;
-    for (size_t k = kSheetMinSide; k + kSheetMinSide <= count; ++k) {
-        double n1 = double(k), n2 = double(count - k);
-        double m1 = sum[k] / n1, m2 = (sum[count] - sum[k]) / n2;
-        double ss1 = std::max(0.0, sq[k] - n1 * m1 * m1), ss2 = std::max(0.0, sq[count] - sq[k] - n2 * m2 * m2);
-        if (ss1 + ss2 < best) {
-            best = ss1 + ss2;
-            double pooled = std::sqrt((ss1 + ss2) / double(count - 2));
-            separation = pooled > 0.0 ? (m2 - m1) / pooled : INFINITY;
-            threshold = 0.5 * (s[k - 1] + s[k]);
-        }
-    }
-    return threshold;
+    if (t.low == 0) return 0.0;
+    const double pooled = std::sqrt(t.squared_deviations / double(count - 2));
+    separation = pooled > 0.0 ? (t.high_mean - t.low_mean) / pooled : INFINITY;
+    return t.threshold;
 }
 
 // Keeps the points of pts on the centre's sheet (pts[0] is the centre) when the nearest

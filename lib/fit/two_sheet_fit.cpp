@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/two_groups.hpp"
+
 namespace gmpu {
 
 namespace {
@@ -26,29 +28,17 @@ struct Groups {
     size_t smaller = 0;
 };
 
-// Otsu's split of the sorted values: the threshold maximising the between-group variance,
-// each group holding at least `min_group` values.
+// The best two-group split of the values (sorted here), each group holding at least
+// `min_group` of them.
 Groups otsu(std::vector<double> &r, size_t min_group) {
-    Groups g;
     std::sort(r.begin(), r.end());
-    const size_t n = r.size();
-    std::vector<double> s(n + 1, 0.0), s2(n + 1, 0.0);
-    for (size_t i = 0; i < n; ++i) s[i + 1] = s[i] + r[i], s2[i + 1] = s2[i] + r[i] * r[i];
-    double best = -1.0;
-    size_t k_best = 0;
-    for (size_t k = min_group; k + min_group <= n; ++k) {
-        const double m0 = s[k] / double(k), m1 = (s[n] - s[k]) / double(n - k);
-        const double between = double(k) * double(n - k) * (m1 - m0) * (m1 - m0);
-        if (between > best) best = between, k_best = k;
-    }
-    if (k_best == 0) return g;
-    const size_t k = k_best;
-    const double m0 = s[k] / double(k), m1 = (s[n] - s[k]) / double(n - k);
-    const double ss0 = s2[k] - double(k) * m0 * m0, ss1 = (s2[n] - s2[k]) - double(n - k) * m1 * m1;
-    g.threshold = 0.5 * (r[k - 1] + r[k]);
-    g.gap = m1 - m0;
-    g.spread = std::sqrt(std::max(0.0, ss0 + ss1) / double(n));
-    g.smaller = std::min(k, n - k);
+    const TwoGroups t = split_two_groups(r, min_group);
+    Groups g;
+    if (t.low == 0) return g;
+    g.threshold = t.threshold;
+    g.gap = t.high_mean - t.low_mean;
+    g.spread = std::sqrt(t.squared_deviations / double(r.size()));
+    g.smaller = std::min(t.low, r.size() - t.low);
     return g;
 }
 
