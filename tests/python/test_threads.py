@@ -163,6 +163,7 @@ def test_refused_worker_threads_cost_speed_not_the_interpreter():
     in the child first (which owns no other task: a limit of 3 leaves room for 2 threads)."""
     import hashlib
     import os
+    from pathlib import Path
     import resource
     import subprocess
     import sys
@@ -191,6 +192,19 @@ def test_refused_worker_threads_cost_speed_not_the_interpreter():
         return apply
 
     env = dict(os.environ, PYTHONPATH=str(BINDINGS), OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1")
+    if os.geteuid() == 0:
+        # nobody may not be able to read the checkout (a clone under `mktemp -d` is 0700):
+        # give the child a world-readable copy of the binding and of the library it loads.
+        import shutil
+        import tempfile
+        from gmpu import _library
+        readable = Path(tempfile.mkdtemp())
+        readable.chmod(0o755)
+        shutil.copytree(BINDINGS / "gmpu", readable / "gmpu", ignore=shutil.ignore_patterns("__pycache__"))
+        shutil.copy(os.path.realpath(_library.library_path), readable / "libgmpu.so.1")
+        for path in readable.rglob("*"):
+            path.chmod(0o755 if path.is_dir() else 0o644)
+        env.update(PYTHONPATH=str(readable), GMPU_LIBRARY=str(readable / "libgmpu.so.1"))
     for nproc in (1, 3):
         try:
             run = subprocess.run([sys.executable, "-c", script], env=env, preexec_fn=limit(nproc),
