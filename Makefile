@@ -121,6 +121,18 @@ test-plugins: deps-plugins build plugins
 	GMPU_BUILD=$(abspath $(BUILD)) GMPU_LIBRARY=$(abspath $(BUILD))/lib/libgmpu.so.1 \
 	  pvpython --force-offscreen-rendering tests/plugins/paraview_test.py
 
+# The README's pictures (docs/plugins/): Cycles on the CPU under blender -b, and ParaView's
+# SaveScreenshot, whose OpenGL context Debian's X11 build of ParaView takes from Xvfb.
+plugin-screenshots: deps-plugins build plugins
+	$(call apt_install,xvfb)
+	@mkdir -p docs/plugins
+	sandbox=$$(mktemp -d) && trap 'rm -rf "$$sandbox"' EXIT && \
+	  GMPU_BUILD=$(abspath $(BUILD)) $(BLENDER_SANDBOX) blender -b --factory-startup --python-exit-code 1 \
+	  --python bindings/blender/screenshot.py -- docs/plugins/blender.png
+	GMPU_BUILD=$(abspath $(BUILD)) GMPU_LIBRARY=$(abspath $(BUILD))/lib/libgmpu.so.1 \
+	  xvfb-run -a -s "-screen 0 1280x1024x24" pvpython --force-offscreen-rendering \
+	  bindings/paraview/screenshot.py docs/plugins/paraview.png
+
 # ---- robustness (issue 6): sanitizers, valgrind, fuzzing, the hostile corpus -------------
 # build-sanitize: clang, ASan + UBSan (any report aborts), the library also carrying
 # libFuzzer's coverage instrumentation, so that one build serves the C suites, the CLI on

@@ -35,7 +35,22 @@ from vtkmodules.vtkCommonExecutionModel import vtkDemandDrivenPipeline
 paraview_plugin_name = "gmpu Reconstruct"
 paraview_plugin_version = "0.1.0"
 
-_HERE = os.path.dirname(os.path.abspath(__file__))
+
+
+def _this_file():
+    """This file's path. `paraview --script=` runs the source without a file name, so then it
+    is looked for on the Python path (README: PYTHONPATH=build/plugins)."""
+    try:
+        return os.path.abspath(__file__)
+    except NameError:
+        for directory in sys.path:
+            candidate = os.path.join(directory or ".", "gmpu_paraview.py")
+            if os.path.isfile(candidate):
+                return os.path.abspath(candidate)
+        return ""
+
+
+_HERE = os.path.dirname(_this_file())
 # The long stages in pipeline order, each a third of the progress bar.
 _STAGES = ("fit", "orient", "polygonize")
 
@@ -68,7 +83,6 @@ class _Aborted(Exception):
 
 
 @smproxy.filter(name="gmpuReconstruct", label="gmpu Reconstruct")
-@smhint.xml('<ShowInMenu category="Alphabetical" />')
 @smproperty.input(name="Input", port_index=0)
 @smdomain.datatype(dataTypes=["vtkPointSet"], composite_data_supported=False)
 class GmpuReconstruct(VTKPythonAlgorithmBase):
@@ -199,8 +213,12 @@ def load(namespace=None):
     gmpuReconstruct goes (e.g. globals())."""
     from paraview.simple import LoadPlugin
 
-    LoadPlugin(os.path.abspath(__file__), remote=False, ns=namespace)
+    path = _this_file()
+    if not path:
+        raise RuntimeError("gmpu_paraview.py is not on the Python path: set PYTHONPATH to its directory")
+    LoadPlugin(path, remote=False, ns=namespace)
 
 
 if __name__ == "__main__":  # paraview --script=gmpu_paraview.py: load it into the GUI
+    print(f"gmpu Reconstruct: loading {_this_file()}")
     load()

@@ -115,6 +115,7 @@ def main():
     check_equal_to_cli(filt, pc.RUNS[1], "after an abort")
 
     configure(filt, dict(pc.RUNS[0], resolution=3))
+    print("(expected: an error message and VTK's \"returned failure\" below)", flush=True)
     filt.UpdatePipeline()
     check("resolution" in algorithm.last_error.lower(),
           f"a parameter the library refuses is an error message: {algorithm.last_error!r}")
