@@ -99,7 +99,7 @@ test-load: build
 # build/plugins holds the add-on zip (the binding bundled inside), the ParaView plugin file and
 # the binding beside it (which the plugin imports when gmpu is not installed).
 PLUGIN_DIR := $(BUILD)/plugins
-PLUGIN_PKGS := blender paraview python3-cffi python3-numpy
+PLUGIN_PKGS := blender paraview python3-cffi python3-numpy xvfb
 # Throwaway Blender user directories: the test installs the add-on, never into ~/.config.
 BLENDER_SANDBOX = BLENDER_USER_SCRIPTS=$$sandbox/scripts BLENDER_USER_CONFIG=$$sandbox/config
 
@@ -113,18 +113,22 @@ plugins:
 deps-plugins:
 	$(call apt_install,$(PLUGIN_PKGS))
 
-# Headless: blender -b, and pvpython with offscreen rendering (tests/plugins/).
+# Headless (tests/plugins/): blender -b; the add-on's modal path and Esc in a Blender window
+# on Xvfb; pvpython.
 test-plugins: deps-plugins build plugins
 	sandbox=$$(mktemp -d) && trap 'rm -rf "$$sandbox"' EXIT && \
 	  env -u GMPU_LIBRARY GMPU_BUILD=$(abspath $(BUILD)) $(BLENDER_SANDBOX) \
 	  blender -b --factory-startup --python-exit-code 1 --python tests/plugins/blender_test.py
+	sandbox=$$(mktemp -d) && trap 'rm -rf "$$sandbox"' EXIT && \
+	  env -u GMPU_LIBRARY GMPU_BUILD=$(abspath $(BUILD)) $(BLENDER_SANDBOX) \
+	  xvfb-run -a -s "-screen 0 1280x1024x24" \
+	  blender --factory-startup --enable-event-simulate --python tests/plugins/blender_ui_test.py
 	GMPU_BUILD=$(abspath $(BUILD)) GMPU_LIBRARY=$(abspath $(BUILD))/lib/libgmpu.so.1 \
 	  pvpython --force-offscreen-rendering tests/plugins/paraview_test.py
 
 # The README's pictures (docs/plugins/): Cycles on the CPU under blender -b, and ParaView's
 # SaveScreenshot, whose OpenGL context Debian's X11 build of ParaView takes from Xvfb.
 plugin-screenshots: deps-plugins build plugins
-	$(call apt_install,xvfb)
 	@mkdir -p docs/plugins
 	sandbox=$$(mktemp -d) && trap 'rm -rf "$$sandbox"' EXIT && \
 	  GMPU_BUILD=$(abspath $(BUILD)) $(BLENDER_SANDBOX) blender -b --factory-startup --python-exit-code 1 \
