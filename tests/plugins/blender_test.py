@@ -116,6 +116,31 @@ def test_runs(cloud):
         check(not diff, f"run {i}: equal to the CLI's mesh ({len(ref_v)} vertices, {len(ref_f)} triangles) {diff}")
 
 
+def test_decimation(cloud):
+    """Target Triangles: decimated (closed, at most the target) when the binding has mesh
+    simplification; otherwise a warning and the full mesh."""
+    activate(cloud)
+    before = set(bpy.data.objects.keys())
+    target = 4000
+    result, error = run_operator(**pc.RUNS[0], target_triangles=target)
+    check(result == {'FINISHED'}, f"Target Triangles {target}: FINISHED {error}")
+    added = [bpy.data.objects[n] for n in set(bpy.data.objects.keys()) - before]
+    if len(added) != 1:
+        check(False, "Target Triangles: one new object")
+        return
+    vertices, faces = mesh_arrays(added[0])
+    gmpu = sys.modules.get(ADDON + ".gmpu")
+    from gmpu_reconstruct import decimation
+
+    if decimation.available(gmpu):
+        check(faces is not None and len(faces) <= target and not pc.closed_problem(faces),
+              f"Target Triangles: a closed mesh of at most {target} triangles")
+    else:
+        ref_v, ref_f = pc.cli_mesh(pc.CLOUD, pc.RUNS[0])
+        check(faces is not None and not pc.difference(vertices, faces, ref_v, ref_f, TOLERANCE),
+              "Target Triangles without mesh simplification in the library: the full mesh (and a warning)")
+
+
 def test_cancel(cloud):
     activate(cloud)
     before = scene_state()
@@ -192,6 +217,7 @@ def main():
         test_install()
         cloud = import_cloud()
         test_runs(cloud)
+        test_decimation(cloud)
         test_cancel(cloud)
         test_failures(cloud)
         test_library_missing()
