@@ -92,6 +92,9 @@ class GmpuReconstruct(VTKPythonAlgorithmBase):
         VTKPythonAlgorithmBase.__init__(self, nInputPorts=1, nOutputPorts=1, outputType="vtkPolyData")
         self._params = {"error": 0.002, "max_depth": 10, "resolution": 0, "noise_scale": 1.75,
                         "sharp_features": False, "threads": 0}
+        self._target_triangles = 0
+        #: The latest run's warning ("" if none), e.g. a decimation the library cannot do.
+        self.last_warning = ""
         #: The latest failure's message ("" after a success or a cancel), for scripts.
         self.last_error = ""
         #: Whether the latest run was aborted.
@@ -107,6 +110,15 @@ class GmpuReconstruct(VTKPythonAlgorithmBase):
             self.Modified()
 
     # Properties appear in the panel in reverse order of declaration.
+    @smproperty.intvector(name="TargetTriangles", label="Target Triangles", default_values=0)
+    @smdomain.intrange(min=0, max=10000000)
+    @smhint.xml('<Documentation>Decimate the surface to about this many triangles, keeping it closed '
+                '(0: keep every triangle). Needs a gmpu library with mesh simplification.</Documentation>')
+    def SetTargetTriangles(self, value):
+        if self._target_triangles != int(value):
+            self._target_triangles = int(value)
+            self.Modified()
+
     @smproperty.intvector(name="Threads", default_values=0)
     @smdomain.intrange(min=0, max=64)
     @smhint.xml('<Documentation>Worker threads; 0 uses every core.</Documentation>')
@@ -158,8 +170,22 @@ class GmpuReconstruct(VTKPythonAlgorithmBase):
         vtkOutputWindow.GetInstance().DisplayErrorText(f"gmpu Reconstruct: {message}\n")
         return 0
 
+    def _decimated(self, gmpu, mesh):
+        """The mesh decimated to the target when asked and the binding can (Mesh.simplify,
+        which keeps the mesh closed and may stop above the target); else the mesh, with a
+        warning when asked."""
+        target = self._target_triangles
+        if target <= 0 or target >= len(mesh.faces):
+            return mesh
+        if not callable(getattr(gmpu.Mesh, "simplify", None)):
+            self.last_warning = (f"Target Triangles ignored: gmpu {gmpu.library_version} has no mesh "
+                                 "simplification; the surface keeps every triangle")
+            vtkOutputWindow.GetInstance().DisplayWarningText(f"gmpu Reconstruct: {self.last_warning}\n")
+            return mesh
+        return mesh.simplify(target_triangles=target)
+
     def RequestData(self, request, inInfo, outInfo):
-        self.last_error, self.last_cancelled = "", False
+        self.last_error, self.last_warning, self.last_cancelled = "", "", False
         source = vtkPointSet.GetData(inInfo[0])
         output = vtkPolyData.GetData(outInfo)
         output.Initialize()
@@ -170,7 +196,7 @@ class GmpuReconstruct(VTKPythonAlgorithmBase):
             return self._fail("the input has no points")
         points = numpy_support.vtk_to_numpy(source.GetPoints().GetData())
         try:
-            mesh = gmpu.reconstruct(points, progress=self._progress, **self._params)
+            mesh = self._decimated(gmpu, gmpu.reconstruct(points, progress=self._progress, **self._params))
         except (_Aborted, gmpu.CancelledError):
             self.last_cancelled = True
             # VTK leaves the abort flag set, which would cancel every later run at its first

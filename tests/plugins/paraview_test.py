@@ -114,6 +114,20 @@ def main():
     check(not algorithm.last_cancelled, "after an abort, the next update runs in full")
     check_equal_to_cli(filt, pc.RUNS[1], "after an abort")
 
+    # Target Triangles: decimated when the library can, else the full mesh and a warning.
+    configure(filt, pc.RUNS[0])
+    filt.TargetTriangles = 4000
+    filt.UpdatePipeline()
+    full = len(pc.cli_mesh(pc.CLOUD, pc.RUNS[0])[1])
+    _, faces, normals = output_arrays(filt)
+    if algorithm.last_warning:
+        check("Target Triangles ignored" in algorithm.last_warning and faces is not None and len(faces) == full,
+              f"Target Triangles without mesh simplification: the full mesh and a warning ({algorithm.last_warning})")
+    else:
+        check(faces is not None and 0 < len(faces) < full and not pc.closed_problem(faces) and normals is not None,
+              f"Target Triangles 4000: a closed surface with fewer triangles than the full {full}, with normals")
+    filt.TargetTriangles = 0
+
     configure(filt, dict(pc.RUNS[0], resolution=3))
     print("(expected: an error message and VTK's \"returned failure\" below)", flush=True)
     filt.UpdatePipeline()
