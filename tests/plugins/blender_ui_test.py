@@ -36,6 +36,32 @@ def invoke(**params):
         return bpy.ops.object.gmpu_reconstruct('INVOKE_DEFAULT', **params)
 
 
+def open_sidebar_panel():
+    """Shows the 3D Viewport's sidebar with the panel, recording each of its draws (an
+    exception in a panel's draw is only printed by Blender). Blender 3.4 cannot switch the
+    sidebar's tab from Python, so the panel is re-registered on the tab shown first."""
+    from gmpu_reconstruct.panel import GMPU_PT_reconstruct
+
+    draws = state["panel_draws"] = []
+    original = GMPU_PT_reconstruct.draw
+
+    def draw(self, context):
+        try:
+            original(self, context)
+            draws.append(True)
+        except Exception:
+            draws.append(False)
+            raise
+
+    GMPU_PT_reconstruct.draw = draw
+    bpy.utils.unregister_class(GMPU_PT_reconstruct)
+    GMPU_PT_reconstruct.bl_category = "Item"
+    bpy.utils.register_class(GMPU_PT_reconstruct)
+    ctx = window_context()
+    ctx["area"].spaces.active.show_region_ui = True
+    ctx["area"].tag_redraw()
+
+
 def finish():
     print(f"blender_ui_test: {len(failures)} failure(s)" if failures else "blender_ui_test: all checks passed",
           flush=True)
@@ -56,6 +82,17 @@ def step():
         bpy.ops.import_mesh.ply(filepath=pc.CLOUD)
         state["cloud"] = bpy.context.active_object
         state["before"] = set(bpy.data.objects.keys())
+        open_sidebar_panel()
+        state["step"], state["since"] = "panel", now
+    elif s == "panel":
+        drawn = state["panel_draws"]
+        if not drawn and now - state["since"] < 20:
+            return 0.2
+        check(drawn and all(ok for ok in drawn), f"sidebar panel drawn without error ({len(drawn)} draws)")
+        shot = os.environ.get("GMPU_UI_SCREENSHOT")
+        if shot:
+            with bpy.context.temp_override(**window_context()):
+                bpy.ops.screen.screenshot(filepath=shot)
         result = invoke(**pc.RUNS[0])
         check(result == {'RUNNING_MODAL'}, f"invoke: the operator runs modal ({result})")
         state["step"] = "wait_run"
