@@ -1,6 +1,4 @@
 """Add-on preferences: where libgmpu is (the zip carries the Python binding, not the library)."""
-from __future__ import annotations
-
 import bpy
 from bpy.props import StringProperty
 
