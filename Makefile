@@ -25,7 +25,8 @@ define apt_install
 endef
 
 .PHONY: all deps deps-test deps-bench build demo test test-c test-python test-node test-rust \
-        test-sanitize bench bench-quick bench-corpus fuzz clean
+        test-sanitize bench bench-quick bench-corpus fuzz clean plugins deps-plugins test-plugins \
+        plugin-screenshots
 
 all: build
 
@@ -58,7 +59,7 @@ demo: build
 	@echo "Oriented points written to $(abspath $(BUILD)/demo/bunny_oriented_points.ply)"
 
 test: deps-test build
-	$(MAKE) --no-print-directory test-c test-load test-python test-node test-rust test-sanitize test-tsan test-valgrind fuzz-quick
+	$(MAKE) --no-print-directory test-c test-load test-python test-node test-rust test-plugins test-sanitize test-tsan test-valgrind fuzz-quick
 
 test-c: build
 	meson test -C $(BUILD) --print-errorlogs
@@ -93,6 +94,48 @@ test-load: build
 	GMPU_CANCEL_POINTS=200000 tests/load/with_busy_cores.sh meson test -C $(BUILD) --no-rebuild --print-errorlogs cancel
 	tests/load/with_busy_cores.sh $(PYTHON) -m pytest tests/python/test_progress.py -q -p no:cacheprovider \
 	  --basetemp=$(BUILD)/pytest-load -k "not ctrl_c"
+
+# ---- plugins (issue 16): the Blender add-on and the ParaView plugin ------------------------
+# build/plugins holds the add-on zip (the binding bundled inside), the ParaView plugin file and
+# the binding beside it (which the plugin imports when gmpu is not installed).
+PLUGIN_DIR := $(BUILD)/plugins
+PLUGIN_PKGS := blender paraview python3-cffi python3-numpy xvfb
+# Throwaway Blender user directories: the test installs the add-on, never into ~/.config.
+BLENDER_SANDBOX = BLENDER_USER_SCRIPTS=$$sandbox/scripts BLENDER_USER_CONFIG=$$sandbox/config
+
+plugins:
+	$(PYTHON) bindings/blender/make_zip.py $(PLUGIN_DIR)/gmpu_reconstruct.zip
+	rm -rf $(PLUGIN_DIR)/gmpu && mkdir -p $(PLUGIN_DIR)/gmpu
+	cp bindings/python/gmpu/*.py bindings/python/gmpu/py.typed $(PLUGIN_DIR)/gmpu/
+	cp bindings/paraview/gmpu_paraview.py $(PLUGIN_DIR)/
+	@echo "ParaView plugin: $(PLUGIN_DIR)/gmpu_paraview.py"
+
+deps-plugins:
+	$(call apt_install,$(PLUGIN_PKGS))
+
+# Headless (tests/plugins/): blender -b; the add-on's modal path and Esc in a Blender window
+# on Xvfb; pvpython.
+test-plugins: deps-plugins build plugins
+	sandbox=$$(mktemp -d) && trap 'rm -rf "$$sandbox"' EXIT && \
+	  env -u GMPU_LIBRARY GMPU_BUILD=$(abspath $(BUILD)) $(BLENDER_SANDBOX) \
+	  blender -b --factory-startup --python-exit-code 1 --python tests/plugins/blender_test.py
+	sandbox=$$(mktemp -d) && trap 'rm -rf "$$sandbox"' EXIT && \
+	  env -u GMPU_LIBRARY GMPU_BUILD=$(abspath $(BUILD)) $(BLENDER_SANDBOX) \
+	  xvfb-run -a -s "-screen 0 1280x1024x24" \
+	  blender --factory-startup --enable-event-simulate --python tests/plugins/blender_ui_test.py
+	GMPU_BUILD=$(abspath $(BUILD)) GMPU_LIBRARY=$(abspath $(BUILD))/lib/libgmpu.so.1 \
+	  pvpython --force-offscreen-rendering tests/plugins/paraview_test.py
+
+# The README's pictures (docs/plugins/): Cycles on the CPU under blender -b, and ParaView's
+# SaveScreenshot, whose OpenGL context Debian's X11 build of ParaView takes from Xvfb.
+plugin-screenshots: deps-plugins build plugins
+	@mkdir -p docs/plugins
+	sandbox=$$(mktemp -d) && trap 'rm -rf "$$sandbox"' EXIT && \
+	  GMPU_BUILD=$(abspath $(BUILD)) $(BLENDER_SANDBOX) blender -b --factory-startup --python-exit-code 1 \
+	  --python bindings/blender/screenshot.py -- docs/plugins/blender.png
+	GMPU_BUILD=$(abspath $(BUILD)) GMPU_LIBRARY=$(abspath $(BUILD))/lib/libgmpu.so.1 \
+	  xvfb-run -a -s "-screen 0 1280x1024x24" pvpython --force-offscreen-rendering \
+	  bindings/paraview/screenshot.py docs/plugins/paraview.png
 
 # ---- robustness (issue 6): sanitizers, valgrind, fuzzing, the hostile corpus -------------
 # build-sanitize: clang, ASan + UBSan (any report aborts), the library also carrying
