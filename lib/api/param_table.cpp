@@ -11,6 +11,7 @@
 
 #include "api/guard.hpp"
 #include "core/error.hpp"
+#include "geometry/octree.hpp"
 
 namespace gmpu::api {
 namespace {
@@ -53,6 +54,15 @@ constexpr bool keys_are_one_to_count() {
 static_assert(keys_are_one_to_count(), "core/param_table.def: rows must be in key order 1, 2, 3... with no gap");
 
 constexpr int kCount = int(std::size(kKeys));
+
+// The depth parameters' ranges end at the octree's deepest level.
+constexpr double kMaxima[] = {
+#define GMPU_PARAM(KEY, field, ctype, TYPE, default_value, lo, hi, ...) hi,
+#include "core/param_table.def"
+#undef GMPU_PARAM
+};
+static_assert(kMaxima[GMPU_PARAM_MAX_DEPTH - 1] == kMaxDepth && kMaxima[GMPU_PARAM_LEVEL - 1] == kMaxDepth,
+              "core/param_table.def: max_depth and level must end at kMaxDepth");
 
 const Row &row(gmpu_param key) { return kRows[int(key) - 1]; }
 

@@ -1,4 +1,5 @@
-// The documentation states what the library does: every parameter's default and range in
+// The documentation states what the library does: gmpu.h documents exactly the keys of the
+// library's parameter table (gmpu_param_info), and every parameter's default and range in
 // gmpu.h ("Default D, range R.") and in the README's parameter table match a fresh surface's
 // values and what gmpu_surface_set_param accepts at and just beyond each bound; the
 // progress cadence and cancel latency quoted in gmpu.h, the README and the bindings' docs
@@ -176,6 +177,7 @@ void readme_parameter_table_is_the_headers(void **) {
             fail_msg("README: %s range \"%s\", gmpu.h \"%s\"", key.c_str(), range.c_str(), doc->second.range.c_str());
     }
     assert_int_equal(rows, params.size());
+    assert_int_equal(rows, size_t(gmpu_param_count()));  // one row per key of the library's table
 }
 
 // Every "at least every N ms", "at most every N ms" and "within N ms" of the progress
