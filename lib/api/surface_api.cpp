@@ -3,8 +3,6 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <cstring>
 #include <limits>
 #include <memory>
 #include <string>
@@ -23,7 +21,6 @@
 #include "core/release_memory.hpp"
 #include "fit/build_octree.hpp"
 #include "fit/noise_estimate.hpp"
-#include "geometry/outliers.hpp"
 #include "geometry/point_set.hpp"
 #include "implicit/mpu_function.hpp"
 #include "implicit/surface_field.hpp"
@@ -136,14 +133,6 @@ void finish_stage(gmpu::Progress &progress) {
     }
     progress.report(1.0, true);
     progress.throw_if_cancelled();
-}
-
-
-// Shortest exact-enough text for a number in a message ("16", "0.002", "1e+09").
-std::string number(double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", v);
-    return buf;
 }
 
 template <class T>

@@ -37,7 +37,7 @@ static int accepted(int key, double value) {
 static void test_every_key_is_described(void **state) {
     (void)state;
     const int count = gmpu_param_count();
-    assert_int_equal(count, GMPU_PARAM_MAX_MEMORY); /* the header's last key; keys are 1..count */
+    assert_true(count >= GMPU_PARAM_MAX_MEMORY); /* keys are 1..count; docs_match checks gmpu.h has them all */
     for (int key = 1; key <= count; ++key) {
         const gmpu_param_info_t info = info_of(key);
         assert_non_null(info.name);
