@@ -221,9 +221,10 @@ GMPU_API gmpu_status gmpu_surface_get_stat(const gmpu_surface *s, gmpu_stat key,
         require_arg(value, "value");
         s->require_idle("gmpu_surface_get_stat");
         gmpu::api::check_stat_key(key);
-        const gmpu::api::StatSources from{s->input_count, s->points,  s->stage >= gmpu_surface::Stage::fitted,
-                                          s->tree,        s->orient_stats, s->seconds,
-                                          s->last_resolution, s->noise, s->epsilon};
+        const gmpu::api::StatSources from{s->input_count,   s->points,  s->stage >= gmpu_surface::Stage::fitted,
+                                          s->tree,          s->orient_stats,
+                                          s->seconds,       s->last_resolution,
+                                          s->noise,         s->epsilon};
         *value = gmpu::api::statistic(key, from);
     });
 }
