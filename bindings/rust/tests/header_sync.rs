@@ -344,9 +344,14 @@ fn drift_is_detected() {
         ("GMPU_PARAM_MAX_MEMORY\t12\n", "GMPU_PARAM_MAX_MEMORY\t12\nenum\tgmpu_param\tGMPU_PARAM_NEW\t13\n"),
         ("GMPU_STAGE_POLYGONIZE\t3\n", "GMPU_STAGE_POLYGONIZE\t3\nenum\tgmpu_stage\tGMPU_STAGE_EXTRA\t4\n"),
         ("GMPU_ERROR_BUSY\t12\n", "GMPU_ERROR_BUSY\t12\nenum\tgmpu_status\tGMPU_ERROR_NEW\t13\n"),
-        ("gmpu_surface_set_points_f64\tgmpu_status\tsurface:gmpu_surface *\txyz:const double *",
-         "gmpu_surface_set_points_f64\tgmpu_status\tsurface:gmpu_surface *\txyz:const float *"),
-        ("gmpu_surface_point_count\tsize_t\tsurface:const gmpu_surface *", "gmpu_surface_point_count\tsize_t\tsurface:gmpu_surface *"),
+        (
+            "gmpu_surface_set_points_f64\tgmpu_status\tsurface:gmpu_surface *\txyz:const double *",
+            "gmpu_surface_set_points_f64\tgmpu_status\tsurface:gmpu_surface *\txyz:const float *",
+        ),
+        (
+            "gmpu_surface_point_count\tsize_t\tsurface:const gmpu_surface *",
+            "gmpu_surface_point_count\tsize_t\tsurface:gmpu_surface *",
+        ),
         ("fn\tgmpu_abi_version\tuint32_t", "fn\tgmpu_abi_version\tuint64_t"),
         ("fn\tgmpu_abi_version\tuint32_t\n", "fn\tgmpu_abi_version\tuint32_t\nfn\tgmpu_new\tint\n"),
         ("fn\tgmpu_abi_version\tuint32_t\n", ""),
