@@ -74,7 +74,7 @@ test-node: build
 
 test-rust: build
 	@command -v cargo >/dev/null || { echo "test-rust: cargo not found (Rust >= 1.77 is needed)"; exit 1; }
-	cd bindings/rust && GMPU_LIB_DIR=$(abspath $(BUILD))/lib cargo test --offline
+	cd bindings/rust && GMPU_LIBRARY=$(abspath $(BUILD))/lib/libgmpu.so.1 cargo test --offline
 	$(MAKE) --no-print-directory test-cross
 
 # Same input and parameters -> same mesh in C, Python, Node and Rust (tests/cross/).

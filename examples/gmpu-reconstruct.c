@@ -4,8 +4,11 @@
  *
  *   gmpu-reconstruct INPUT -o OUTPUT [--normals-out POINTS.ply] [--error E]
  *                    [--max-depth D] [--resolution R] [--level L] [--threads T]
- *                    [--noise-scale S] [--max-memory BYTES]
+ *                    [--noise-scale S] [--max-memory BYTES] [--param NAME=VALUE]...
  *                    [--use-normals] [--sharp] [--quiet] [--version]
+ *
+ * --param sets any parameter of the library's table by name (gmpu_param_key); --help lists
+ * them all with their defaults and ranges (gmpu_param_info).
  *
  * Output format from the extension (.ply, .obj, .off). Exit status 0 on success, 1 on a
  * failure (one line on stderr), 2 on bad usage. The outputs are checked before any work
@@ -24,21 +27,66 @@
 #include "cli/staged_output.h"
 #include "gmpu/gmpu.h"
 
+#define MAX_PARAMS 64
+
 typedef struct {
     const char *input, *output, *normals_out;
     double error, max_depth, resolution, level, threads, noise_scale, max_memory;
     int use_normals, sharp, quiet;
+    int param_count; /* --param NAME=VALUE, applied after the flags above, in order */
+    gmpu_param param_keys[MAX_PARAMS];
+    double param_values[MAX_PARAMS];
 } options;
+
+static int parse_number(const char *flag, const char *text, double *out);
 
 static const char *usage =
     "usage: gmpu-reconstruct INPUT -o OUTPUT [--normals-out POINTS.ply] [--error E]\n"
     "                        [--max-depth D] [--resolution R] [--level L] [--threads T]\n"
-    "                        [--noise-scale S] [--max-memory BYTES]\n"
+    "                        [--noise-scale S] [--max-memory BYTES] [--param NAME=VALUE]...\n"
     "                        [--use-normals] [--sharp] [--quiet] [--version]\n"
     "  INPUT   .ply .xyz .txt .off .obj point cloud (normals ignored unless --use-normals)\n"
     "  OUTPUT  .ply .obj .off mesh (closed, outward-facing)\n"
     "  Options take their value as the next argument or after '=' (--resolution=64).\n"
-    "  A file name starting with '-' must be written ./-name.\n";
+    "  A file name starting with '-' must be written ./-name.\n"
+    "  --param NAME=VALUE sets any parameter (--help lists them).\n";
+
+/* Every parameter of the library's table: name, type, default, range, doc. */
+static void print_parameters(FILE *out) {
+    fputs("\nparameters (--param NAME=VALUE):\n", out);
+    for (int key = 1; key <= gmpu_param_count(); ++key) {
+        gmpu_param_info_t p;
+        if (gmpu_param_info((gmpu_param)key, &p) != GMPU_OK) continue;
+        char range[64];
+        snprintf(range, sizeof range, "%c%g, %g%c", p.min_exclusive ? '(' : '[', p.min, p.max, p.max_exclusive ? ')' : ']');
+        fprintf(out, "  %-15s %-4s default %-11g %-15s %s\n", p.name, p.type == GMPU_TYPE_INT ? "int" : "real",
+                p.default_value, range, p.doc);
+    }
+}
+
+/* --param NAME=VALUE: the key by the library's name, the value a number. */
+static int parse_param(const char *text, options *o) {
+    const char *eq = text ? strchr(text, '=') : NULL;
+    char name[64];
+    if (!eq || (size_t)(eq - text) >= sizeof name) {
+        fprintf(stderr, "gmpu-reconstruct: --param needs NAME=VALUE, got '%s'\n", text ? text : "");
+        return 0;
+    }
+    memcpy(name, text, (size_t)(eq - text));
+    name[eq - text] = '\0';
+    const int key = gmpu_param_key(name);
+    if (key == 0) {
+        fprintf(stderr, "gmpu-reconstruct: --param: unknown parameter '%s' (--help lists them)\n", name);
+        return 0;
+    }
+    if (o->param_count == MAX_PARAMS) {
+        fprintf(stderr, "gmpu-reconstruct: more than %d --param options\n", MAX_PARAMS);
+        return 0;
+    }
+    if (!parse_number(name, eq + 1, &o->param_values[o->param_count])) return 0;
+    o->param_keys[o->param_count++] = (gmpu_param)key;
+    return 1;
+}
 
 static int parse_number(const char *flag, const char *text, double *out) {
     char *end = NULL;
@@ -64,7 +112,7 @@ static int parse_path(const char *flag, const char *text, const char **out) {
 }
 
 enum { OPT_NORMALS_OUT = 256, OPT_ERROR, OPT_MAX_DEPTH, OPT_RESOLUTION, OPT_LEVEL, OPT_THREADS, OPT_USE_NORMALS,
-       OPT_SHARP, OPT_NOISE_SCALE, OPT_MAX_MEMORY };
+       OPT_SHARP, OPT_NOISE_SCALE, OPT_MAX_MEMORY, OPT_PARAM };
 
 static const struct option long_options[] = {
     {"output", required_argument, NULL, 'o'},
@@ -76,6 +124,7 @@ static const struct option long_options[] = {
     {"threads", required_argument, NULL, OPT_THREADS},
     {"noise-scale", required_argument, NULL, OPT_NOISE_SCALE},
     {"max-memory", required_argument, NULL, OPT_MAX_MEMORY},
+    {"param", required_argument, NULL, OPT_PARAM},
     {"use-normals", no_argument, NULL, OPT_USE_NORMALS},
     {"sharp", no_argument, NULL, OPT_SHARP},
     {"quiet", no_argument, NULL, 'q'},
@@ -111,7 +160,10 @@ static int parse_args(int argc, char **argv, options *o) {
             case 1:
                 if (!positional(o, optarg)) return 0;
                 break;
-            case 'h': fputs(usage, stdout); exit(0);
+            case 'h':
+                fputs(usage, stdout);
+                print_parameters(stdout);
+                exit(0);
             case 'V':
                 printf("gmpu-reconstruct %d.%d.%d (library %s, ABI %u)\n", GMPU_VERSION_MAJOR, GMPU_VERSION_MINOR,
                        GMPU_VERSION_PATCH, gmpu_version_string(), (unsigned)gmpu_abi_version());
@@ -129,6 +181,7 @@ static int parse_args(int argc, char **argv, options *o) {
             case OPT_THREADS: if (!parse_number(flag, optarg, &o->threads)) return 0; break;
             case OPT_NOISE_SCALE: if (!parse_number(flag, optarg, &o->noise_scale)) return 0; break;
             case OPT_MAX_MEMORY: if (!parse_number(flag, optarg, &o->max_memory)) return 0; break;
+            case OPT_PARAM: if (!parse_param(optarg, o)) return 0; break;
             case OPT_USE_NORMALS: o->use_normals = 1; break;
             case OPT_SHARP: o->sharp = 1; break;
             case 'q': o->quiet = 1; break;
@@ -297,6 +350,11 @@ int main(int argc, char **argv) {
         rc = fail("bad parameter");
         goto done;
     }
+    for (int k = 0; k < o.param_count; ++k)
+        if (!set(surface, o.param_keys[k], o.param_values[k])) {
+            rc = fail("bad parameter");
+            goto done;
+        }
     gmpu_surface_set_progress(surface, on_progress, &prog);
     if (gmpu_surface_set_points_f64(surface, gmpu_points_positions(cloud), n, 0) != GMPU_OK) {
         rc = fail("bad input points");

@@ -61,35 +61,59 @@ export type Stage = 'fit' | 'orient' | 'polygonize';
  */
 export type ProgressCallback = (stage: Stage, fraction: number) => boolean | void;
 
-/** The parameters (gmpu_param), by name; see include/gmpu/gmpu.h for ranges. */
+/**
+ * The parameters (gmpu_param), by name. Their defaults, ranges and docs are the library's:
+ * see parameterInfo() (tests/node/api.test.mjs checks these names against it).
+ */
 export interface Parameters {
-    /** ε: largest fit error, as a fraction of the bounding-box diagonal. Default 0.002, (0, 1). */
+    /** ε: largest fit error, as a fraction of the bounding-box diagonal. */
     error?: number;
-    /** Deepest octree level. Default 10, 1..16. */
+    /** Deepest octree level. */
     maxDepth?: number;
-    /** Fewest points per local fit. Default 15, 6..1000. */
+    /** Fewest points per local fit. */
     minPoints?: number;
-    /** α: support radius = α × cell diagonal. Default 0.75, [0.5, 2]. */
+    /** α: support radius = α × cell diagonal. */
     supportScale?: number;
-    /** Piecewise quadrics at sharp edges and corners. Default false (0). */
+    /** Piecewise quadrics at sharp edges and corners (true or 1). */
     sharpFeatures?: boolean | number;
-    /** Polygonize grid cubes along the longest side; 0 picks from the octree; or 8..4096. Default 0. */
+    /** Polygonize grid cubes along the longest side; 0 picks from the octree. */
     resolution?: number;
-    /** Level of detail: use octree cells down to this level only; 0 = all. Default 0. */
+    /** Level of detail: use octree cells down to this level only; 0 = all. */
     level?: number;
-    /** Worker threads; 0 = every core. Default 0. */
+    /** Worker threads; 0 = every core. */
     threads?: number;
-    /** Cap on octree cells (GMPU_ERROR_LIMIT_EXCEEDED beyond). Default 2e7. */
+    /** Cap on octree cells (GMPU_ERROR_LIMIT_EXCEEDED beyond). */
     maxCells?: number;
-    /** Cap on polygonize triangles. Default 1e8. */
+    /** Cap on polygonize triangles. */
     maxTriangles?: number;
-    /** Noise floor for ε, in units of the estimated noise; 0 = off. Default 1.75, [0, 20]. */
+    /** Noise floor for ε, in units of the estimated noise; 0 = off. */
     noiseScale?: number;
-    /** Memory budget in bytes: fit and polygonize fail (GMPU_ERROR_LIMIT_EXCEEDED) when their estimated peak exceeds it. Default half the physical memory; 1e6..1e15. */
+    /** Memory budget in bytes that fit and polygonize check their estimated peak against. */
     maxMemory?: number;
 }
 export type ParameterName = keyof Parameters;
 export declare const parameterNames: readonly ParameterName[];
+
+/** One row of the library's parameter table (gmpu_param_info). */
+export interface ParameterInfo {
+    readonly key: number;
+    /** camelCase name (the Surface option). */
+    readonly name: ParameterName;
+    /** The C library's name (snake_case). */
+    readonly cName: string;
+    readonly type: 'int' | 'real';
+    /** A new surface's value. */
+    readonly default: number;
+    readonly min: number;
+    readonly max: number;
+    readonly minExclusive: boolean;
+    readonly maxExclusive: boolean;
+    /** Changing it discards a previous fit. */
+    readonly refits: boolean;
+    readonly doc: string;
+}
+/** Every parameter as the library describes it, in key order. */
+export declare function parameterInfo(): readonly ParameterInfo[];
 
 export interface SurfaceOptions extends Parameters {
     onProgress?: ProgressCallback | null;

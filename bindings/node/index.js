@@ -67,20 +67,47 @@ function check(status, handle) {
 
 // ---- parameters, stages, statistics ----------------------------------------------------
 
-const PARAMS = Object.freeze({
-    error: 1,
-    maxDepth: 2,
-    minPoints: 3,
-    supportScale: 4,
-    sharpFeatures: 5,
-    resolution: 6,
-    level: 7,
-    threads: 8,
-    maxCells: 9,
-    maxTriangles: 10,
-    noiseScale: 11,
-    maxMemory: 12,
-});
+// The library's parameter table (gmpu_param_count / gmpu_param_info): names, keys, types,
+// defaults, ranges and docs all come from libgmpu, read once, on first use.
+let paramTable = null;
+const camelCase = (snake) => snake.replace(/_(\w)/g, (_, c) => c.toUpperCase());
+
+function paramsByName() {
+    if (paramTable) return paramTable;
+    const n = lib();
+    const rows = new Map();
+    for (let key = 1; key <= n.param_count(); ++key) {
+        const info = {};
+        check(n.param_info(key, info));
+        const integer = info.type === n.TYPE_INT;
+        const row = Object.freeze({
+            key,
+            name: camelCase(info.name),
+            cName: info.name,
+            type: integer ? 'int' : 'real',
+            default: info.default_value,
+            min: info.min,
+            max: info.max,
+            minExclusive: info.min_exclusive !== 0,
+            maxExclusive: info.max_exclusive !== 0,
+            refits: info.refits !== 0,
+            doc: info.doc,
+        });
+        rows.set(row.name, row);
+    }
+    paramTable = rows;
+    return rows;
+}
+
+// Read at import when the library loads, so that the names are a plain array; when it does
+// not, the list is empty and the first call reports why.
+function namesAtImport() {
+    try {
+        return [...paramsByName().keys()];
+    } catch {
+        return [];
+    }
+}
 
 const STATS = Object.freeze({
     points: 1,
@@ -105,13 +132,18 @@ const STATS = Object.freeze({
 const STAGES = Object.freeze({ 1: 'fit', 2: 'orient', 3: 'polygonize' });
 
 /** Names of the parameters (Surface options) and statistics. */
-export const parameterNames = Object.freeze(Object.keys(PARAMS));
+export const parameterNames = Object.freeze(namesAtImport());
 export const statisticNames = Object.freeze(Object.keys(STATS));
 
+/** The library's description of every parameter (key, type, default, range, doc), in key order. */
+export function parameterInfo() {
+    return [...paramsByName().values()];
+}
+
 function paramKey(name) {
-    if (!Object.hasOwn(PARAMS, name))
-        throw invalidArgument(`unknown parameter '${String(name)}' (one of: ${parameterNames.join(', ')})`);
-    return PARAMS[name];
+    const row = paramsByName().get(name);
+    if (!row) throw invalidArgument(`unknown parameter '${String(name)}' (one of: ${[...paramsByName().keys()].join(', ')})`);
+    return row.key;
 }
 
 function paramValue(name, value) {
@@ -337,7 +369,7 @@ export class Surface {
 
     /** Every parameter, by name. */
     params() {
-        return Object.fromEntries(parameterNames.map((name) => [name, this.getParam(name)]));
+        return Object.fromEntries([...paramsByName().keys()].map((name) => [name, this.getParam(name)]));
     }
 
     /** Every statistic, by name. */
@@ -602,10 +634,10 @@ function applyOptions(surface, options, extra) {
         if (key === 'onProgress') {
             if (value !== null && typeof value !== 'function') throw invalidArgument('onProgress must be a function');
             surface.onProgress = value;
-        } else if (Object.hasOwn(PARAMS, key)) {
+        } else if (paramsByName().has(key)) {
             surface.setParam(key, value);
         } else {
-            throw invalidArgument(`unknown option '${key}' (options: ${[...parameterNames, 'onProgress', ...extra].join(', ')})`);
+            throw invalidArgument(`unknown option '${key}' (options: ${[...paramsByName().keys(), 'onProgress', ...extra].join(', ')})`);
         }
     }
 }

@@ -1,7 +1,8 @@
 //! Finds libgmpu and extracts the README's Rust example for `tests/readme.rs`.
 //!
 //! Library search order (the first that applies wins):
-//!   1. `GMPU_LIB_DIR`: a directory holding libgmpu.so;
+//!   1. `GMPU_LIBRARY`: the library file (libgmpu.so.1), or a directory holding it, as for
+//!      the Python and Node bindings (`GMPU_LIB_DIR`, a directory, is still read after it);
 //!   2. pkg-config's `gmpu.pc`, if installed (`pkg-config --libs gmpu`, run as a command;
 //!      PKG_CONFIG_PATH is honoured);
 //!   3. the meson build directory of this source tree, `../../build/lib`.
@@ -51,10 +52,28 @@ fn link_dir(dir: &str) {
 }
 
 fn find_library() {
+    println!("cargo:rerun-if-env-changed=GMPU_LIBRARY");
     println!("cargo:rerun-if-env-changed=GMPU_LIB_DIR");
     println!("cargo:rerun-if-env-changed=PKG_CONFIG_PATH");
     println!("cargo:rerun-if-env-changed=PKG_CONFIG");
     let manifest = PathBuf::from(env::var("CARGO_MANIFEST_DIR").unwrap());
+
+    if let Some(path) = env::var_os("GMPU_LIBRARY").filter(|d| !d.is_empty()) {
+        let path = PathBuf::from(path);
+        let path = if path.is_relative() { manifest.join(path) } else { path };
+        let file = if path.is_dir() { path.join("libgmpu.so.1") } else { path };
+        if !file.is_file() {
+            panic!("GMPU_LIBRARY={}: no such file (build the library with `make build`)", file.display());
+        }
+        let file = file.canonicalize().unwrap_or(file);
+        let dir = file.parent().unwrap().to_string_lossy().into_owned();
+        link_dir(&dir);
+        println!("cargo:root={dir}");
+        // The file itself, by its name (libgmpu.so.1 has no libgmpu.so beside it when only
+        // the runtime library is installed).
+        println!("cargo:rustc-link-lib=dylib:+verbatim={}", file.file_name().unwrap().to_string_lossy());
+        return;
+    }
 
     if let Some(dir) = env::var_os("GMPU_LIB_DIR").filter(|d| !d.is_empty()) {
         let dir = PathBuf::from(dir);
@@ -95,7 +114,7 @@ fn find_library() {
     }
 
     panic!(
-        "libgmpu not found: set GMPU_LIB_DIR to the directory holding libgmpu.so, install gmpu \
+        "libgmpu not found: set GMPU_LIBRARY to the path of libgmpu.so.1, install gmpu \
          (meson install, so that `pkg-config --libs gmpu` works), or build it in this tree with \
          `make build` (expected at {})",
         build.display()

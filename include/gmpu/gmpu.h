@@ -48,11 +48,12 @@
 
 /* Version of this header. Compare with gmpu_version_number() to detect a mismatched
  * library at run time. GMPU_ABI_VERSION changes only when the ABI breaks (it is the
- * SONAME's number: libgmpu.so.1). */
+ * SONAME's number: libgmpu.so.1). The minor version grows with every addition:
+ *   0.3: the parameter table (gmpu_param_count, gmpu_param_info, gmpu_param_key). */
 #define GMPU_VERSION_MAJOR 0
-#define GMPU_VERSION_MINOR 2
+#define GMPU_VERSION_MINOR 3
 #define GMPU_VERSION_PATCH 0
-#define GMPU_VERSION_NUMBER 200 /* MAJOR*10000 + MINOR*100 + PATCH */
+#define GMPU_VERSION_NUMBER 300 /* MAJOR*10000 + MINOR*100 + PATCH */
 #define GMPU_ABI_VERSION 1
 
 #ifdef __cplusplus
@@ -152,6 +153,36 @@ typedef enum gmpu_param {
      * work the machine cannot hold. Default half the physical memory, range 1e6..1e15. */
     GMPU_PARAM_MAX_MEMORY = 12
 } gmpu_param;
+
+/* The parameter table: what every gmpu_param key is, for bindings and tools that list,
+ * document or validate parameters without restating them. Keys are 1..gmpu_param_count(),
+ * with no gaps. */
+typedef enum gmpu_value_type {
+    GMPU_TYPE_INT = 1,  /* only whole numbers are accepted (0/1 for a switch) */
+    GMPU_TYPE_REAL = 2
+} gmpu_value_type;
+
+typedef struct gmpu_param_info_t {
+    const char *name;       /* "max_depth": the enumerator's suffix, lower case */
+    gmpu_value_type type;
+    double default_value;   /* a new surface's value (GMPU_PARAM_MAX_MEMORY's is this machine's) */
+    double min, max;        /* the accepted range */
+    int min_exclusive;      /* 1 when min itself is refused */
+    int max_exclusive;      /* 1 when max itself is refused */
+    int refits;             /* 1 when changing the value discards a previous fit */
+    const char *doc;        /* one line: what the parameter does */
+} gmpu_param_info_t;
+
+/* Number of parameter keys: they are 1..gmpu_param_count(). */
+GMPU_API int gmpu_param_count(void);
+
+/* Fills *info for key. The strings are the library's (static storage, never freed).
+ * Errors: INVALID_ARGUMENT (info is NULL, or key is not 1..gmpu_param_count()). */
+GMPU_API gmpu_status gmpu_param_info(gmpu_param key, gmpu_param_info_t *info);
+
+/* The key whose name is name ("max_depth", or its enumerator "GMPU_PARAM_MAX_DEPTH");
+ * 0 when there is none or name is NULL. */
+GMPU_API int gmpu_param_key(const char *name);
 
 typedef enum gmpu_stage {
     GMPU_STAGE_FIT = 1,

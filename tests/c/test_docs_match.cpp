@@ -1,8 +1,10 @@
-// The documentation states what the library does: every parameter's default and range in
+// The documentation states what the library does: gmpu.h documents exactly the keys of the
+// library's parameter table (gmpu_param_info), and every parameter's default and range in
 // gmpu.h ("Default D, range R.") and in the README's parameter table match a fresh surface's
 // values and what gmpu_surface_set_param accepts at and just beyond each bound; the
 // progress cadence and cancel latency quoted in gmpu.h, the README and the bindings' docs
 // are the library's own constants (core/progress.hpp).
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -66,20 +68,18 @@ std::map<std::string, Documented> header_params() {
     return out;
 }
 
-const std::map<std::string, gmpu_param> kKeys = {
-    {"GMPU_PARAM_ERROR", GMPU_PARAM_ERROR},
-    {"GMPU_PARAM_MAX_DEPTH", GMPU_PARAM_MAX_DEPTH},
-    {"GMPU_PARAM_MIN_POINTS", GMPU_PARAM_MIN_POINTS},
-    {"GMPU_PARAM_SUPPORT_SCALE", GMPU_PARAM_SUPPORT_SCALE},
-    {"GMPU_PARAM_SHARP_FEATURES", GMPU_PARAM_SHARP_FEATURES},
-    {"GMPU_PARAM_RESOLUTION", GMPU_PARAM_RESOLUTION},
-    {"GMPU_PARAM_LEVEL", GMPU_PARAM_LEVEL},
-    {"GMPU_PARAM_THREADS", GMPU_PARAM_THREADS},
-    {"GMPU_PARAM_MAX_CELLS", GMPU_PARAM_MAX_CELLS},
-    {"GMPU_PARAM_MAX_TRIANGLES", GMPU_PARAM_MAX_TRIANGLES},
-    {"GMPU_PARAM_NOISE_SCALE", GMPU_PARAM_NOISE_SCALE},
-    {"GMPU_PARAM_MAX_MEMORY", GMPU_PARAM_MAX_MEMORY},
-};
+// The library's parameter table: enumerator name → key, for every key gmpu_param_info knows.
+std::map<std::string, gmpu_param> library_keys() {
+    std::map<std::string, gmpu_param> out;
+    for (int key = 1; key <= gmpu_param_count(); ++key) {
+        gmpu_param_info_t info{};
+        assert_int_equal(gmpu_param_info(gmpu_param(key), &info), GMPU_OK);
+        std::string enumerator = "GMPU_PARAM_";
+        for (const char *c = info.name; *c; ++c) enumerator += char(std::toupper(static_cast<unsigned char>(*c)));
+        out[enumerator] = gmpu_param(key);
+    }
+    return out;
+}
 
 
 double number(const std::string &text, const std::string &what) {
@@ -143,10 +143,12 @@ void check_range(const std::string &key, gmpu_param k, const std::string &range)
 
 void header_defaults_and_ranges_are_the_librarys(void **) {
     const auto params = header_params();
-    assert_int_equal(params.size(), kKeys.size());  // a new key needs its line in kKeys
+    const auto keys = library_keys();
+    for (const auto &[key, value] : keys)
+        if (!params.count(key)) fail_msg("the library's table has %s, which gmpu.h does not document", key.c_str());
     for (const auto &[key, doc] : params) {
-        auto k = kKeys.find(key);
-        if (k == kKeys.end()) fail_msg("gmpu.h documents %s, unknown to this test: add it to kKeys", key.c_str());
+        auto k = keys.find(key);
+        if (k == keys.end()) fail_msg("gmpu.h documents %s, which the library's table lacks", key.c_str());
         const double expected = documented_default(doc.default_text, key + " default");
         const double actual = library_default(k->second);
         if (actual != expected)
@@ -169,12 +171,13 @@ void readme_parameter_table_is_the_headers(void **) {
         if (doc == params.end()) fail_msg("README documents %s, which gmpu.h does not", key.c_str());
         std::string shown = (*it)[2].str(), range = (*it)[3].str();
         shown = shown.substr(0, shown.find(' '));  // "0 (auto)" → "0"
-        const double v = documented_default(shown, "README default of " + key), expected = library_default(kKeys.at(key));
+        const double v = documented_default(shown, "README default of " + key), expected = library_default(library_keys().at(key));
         if (v != expected) fail_msg("README: %s default %s, the library's %.17g", key.c_str(), shown.c_str(), expected);
         if (range.compare(0, doc->second.range.size(), doc->second.range) != 0)
             fail_msg("README: %s range \"%s\", gmpu.h \"%s\"", key.c_str(), range.c_str(), doc->second.range.c_str());
     }
     assert_int_equal(rows, params.size());
+    assert_int_equal(rows, size_t(gmpu_param_count()));  // one row per key of the library's table
 }
 
 // Every "at least every N ms", "at most every N ms" and "within N ms" of the progress

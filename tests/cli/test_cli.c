@@ -437,7 +437,7 @@ static void test_outputs(void **state) {
     while (last > r.err && last[-1] != '\n') --last;
     assert_int_equal(strncmp(last, "gmpu-reconstruct: cannot write mesh: GMPU_ERROR_UNSUPPORTED", 58), 0);
     /* And the good run: exit 0, a closed sphere, the statistics on stderr. */
-    const char *a7[] = {in, "-o", off, "--resolution", "24", NULL};
+    const char *a7[] = {in, "-o", off, "--param", "resolution=24", NULL};
     r = run_cli(a7);
     check_run(&r, 0, "3000 points");
     const double c[3] = {0, 0, 0};
@@ -469,6 +469,11 @@ static void test_bad_usage(void **state) {
         {{in, "-o", out, "--resolution", "4", "--quiet", NULL}, 1, "GMPU_PARAM_RESOLUTION"},
         {{in, "-o", out, "--max-depth", "99", "--quiet", NULL}, 1, "GMPU_PARAM_MAX_DEPTH"},
         {{in, "-o", out, "--level", "-1", "--quiet", NULL}, 1, "GMPU_PARAM_LEVEL"},
+        {{in, "-o", out, "--param", "no_such=1", NULL}, 2, "unknown parameter 'no_such'"},
+        {{in, "-o", out, "--param", "max_depth", NULL}, 2, "--param needs NAME=VALUE"},
+        {{in, "-o", out, "--param", "max_depth=abc", NULL}, 2, "max_depth needs a number, got 'abc'"},
+        {{in, "-o", out, "--param", "max_depth=99", "--quiet", NULL}, 1, "GMPU_PARAM_MAX_DEPTH"},
+        {{in, "-o", out, "--param", "GMPU_PARAM_NOISE_SCALE=-1", "--quiet", NULL}, 1, "GMPU_PARAM_NOISE_SCALE"},
     };
     for (size_t k = 0; k < sizeof cases / sizeof *cases; ++k) {
         run_result r = run_cli(cases[k].args);

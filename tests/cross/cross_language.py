@@ -15,7 +15,7 @@ The programs (run from the repository root):
     Node    node examples/node/reconstruct.mjs IN OUT FLAGS
     Rust    cargo run --offline --example reconstruct (bindings/rust) -- IN OUT FLAGS
 Every binding is pointed at the same library, BUILD/lib/libgmpu.so.1 (GMPU_LIBRARY for
-Python and Node, GMPU_LIB_DIR for the Rust crate; the C CLI has it in its RUNPATH).
+Python, Node and the Rust crate; the C CLI has it in its RUNPATH).
 
 Only the standard library is used. Exit status 0 when every language matches, 1 otherwise.
 """
@@ -271,7 +271,7 @@ def command(lang: str, build: str, src: str, out: str) -> Tuple[Optional[List[st
             return None, env, manifest
         if not cargo:
             return None, env, "the cargo executable"
-        env["GMPU_LIB_DIR"] = os.path.join(build, "lib")
+        env["GMPU_LIBRARY"] = os.path.join(build, "lib", "libgmpu.so.1")
         return [cargo, "run", "--offline", "--quiet", "--manifest-path", manifest, "--example", "reconstruct",
                 "--", src, out] + FLAGS, env, ""
     raise ValueError(lang)

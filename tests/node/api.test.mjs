@@ -1,4 +1,5 @@
-// The package's surface: exports vs index.d.ts, enums and functions vs include/gmpu/gmpu.h,
+// The package's surface: exports vs index.d.ts, enums and functions vs bindings/abi.txt (the
+// ABI summary generated from include/gmpu/gmpu.h; the Python tests keep it current),
 // a TypeScript type check of typical use, and self-checks of the test helpers.
 import assert from 'node:assert/strict';
 import { spawnSync } from 'node:child_process';
@@ -11,7 +12,9 @@ import { meshTopology, packageDir, packageUrl, readPly, repoRoot, tempDir } from
 
 const gmpu = await import(packageUrl);
 const dts = fs.readFileSync(path.join(packageDir, 'index.d.ts'), 'utf8');
-const header = fs.readFileSync(path.join(repoRoot, 'include', 'gmpu', 'gmpu.h'), 'utf8');
+// One declaration per line, tab-separated: [kind, ...fields].
+const abi = fs.readFileSync(path.join(repoRoot, 'bindings', 'abi.txt'), 'utf8')
+    .split('\n').filter((l) => l && !l.startsWith('#')).map((l) => l.split('\t'));
 
 test('index.js exports exactly the values index.d.ts declares', () => {
     const declared = [...dts.matchAll(/^export (?:declare )?(const|function|class|type|interface) (\w+)/gm)];
@@ -29,47 +32,57 @@ test('index.js exports exactly the values index.d.ts declares', () => {
 });
 
 const camel = (snake) => snake.toLowerCase().replace(/_(\w)/g, (_, c) => c.toUpperCase());
-const headerEnum = (prefix) => [...header.matchAll(new RegExp(`\\b${prefix}(\\w+) = (\\d+)`, 'g'))].map(([, n, v]) => [n, Number(v)]);
+const abiEnum = (type) => abi.filter(([kind, t]) => kind === 'enum' && t === type).map(([, , n, v]) => [n, Number(v)]);
+const headerEnum = (type, prefix) => abiEnum(type).map(([n, v]) => [n.slice(prefix.length), v]);
 
-test('status codes, parameters and statistics match include/gmpu/gmpu.h', () => {
-    const statuses = [...header.matchAll(/\b(GMPU_(?:OK|ERROR_\w+)) = (\d+)/g)].map(([, n, v]) => [n, Number(v)]);
+test('status codes, parameters and statistics match the ABI summary', () => {
+    const statuses = abiEnum('gmpu_status');
     assert.ok(statuses.length >= 12);
     assert.deepEqual(Object.entries(gmpu.Status), statuses);
     assert.ok(Object.isFrozen(gmpu.Status));
 
-    const params = headerEnum('GMPU_PARAM_');
-    assert.deepEqual(params.map(([, v]) => v), params.map((_, i) => i + 1), 'parameter values are 1..n');
+    const params = headerEnum('gmpu_param', 'GMPU_PARAM_');
     assert.deepEqual([...gmpu.parameterNames], params.map(([n]) => camel(n)));
-    const stats = headerEnum('GMPU_STAT_');
+    const stats = headerEnum('gmpu_stat', 'GMPU_STAT_');
     assert.deepEqual(stats.map(([, v]) => v), stats.map((_, i) => i + 1), 'statistic values are 1..n');
     assert.deepEqual([...gmpu.statisticNames], stats.map(([n]) => camel(n)));
     // Every name is in the .d.ts interfaces.
     for (const name of [...gmpu.parameterNames, ...gmpu.statisticNames]) assert.match(dts, new RegExp(`^ {4}${name}\\??: `, 'm'));
 });
 
-test('every function of the C header is declared in lib/native.js', () => {
+test('every function of the ABI summary is declared in lib/native.js, and nothing else', () => {
     const native = fs.readFileSync(path.join(packageDir, 'lib', 'native.js'), 'utf8');
-    const functions = [...header.matchAll(/^GMPU_API [^;]*?\b(gmpu_\w+)\(/gm)].map((m) => m[1]);
+    const functions = abi.filter(([kind]) => kind === 'fn').map(([, name]) => name);
     assert.ok(functions.length >= 35, `${functions.length} functions found in the header`);
     const missing = functions.filter((f) => !native.includes(`'${f}'`));
     assert.deepEqual(missing, []);
+    const declared = [...native.matchAll(/'(gmpu_\w+)'/g)].map((m) => m[1]);
+    assert.deepEqual(declared.filter((f) => !functions.includes(f)), []);
+    // gmpu_param_info_t's fields, in order.
+    const fields = abi.filter(([kind, t]) => kind === 'field' && t === 'gmpu_param_info_t').map(([, , n]) => n);
+    const at = native.indexOf('koffi.struct({');
+    const block = native.slice(at, native.indexOf('})', at));
+    assert.deepEqual([...block.matchAll(/^\s+(\w+): '/gm)].map((m) => m[1]), fields);
+    assert.match(native, new RegExp(`TYPE_INT: ${Object.fromEntries(abiEnum('gmpu_value_type')).GMPU_TYPE_INT},`));
 });
 
-test('the defaults index.d.ts documents are the library\'s', () => {
+test('parameterInfo() is the library\'s table: a new surface\'s values, its ranges enforced', () => {
+    const info = gmpu.parameterInfo();
+    assert.deepEqual(info.map((p) => p.name), [...gmpu.parameterNames]);
+    assert.deepEqual(info.map((p) => p.key), info.map((_, i) => i + 1));
     const s = new gmpu.Surface();
     try {
         const actual = s.params();
-        const body = dts.slice(dts.indexOf('export interface Parameters'));
-        const documented = [...body.slice(0, body.indexOf('\n}')).matchAll(/Default (false|true|[\d.e]+)[^\n]*\n\s*(\w+)\?:/g)];
+        for (const p of info) {
+            assert.equal(actual[p.name], p.default, p.name);
+            assert.equal(p.name, camel(p.cName), p.name);
+            assert.ok(p.doc.length > 10 && p.min < p.max, p.name);
+            const beyond = p.max + (p.type === 'int' ? 1 : p.max * 1e-9 + 1e-12);
+            assert.throws(() => s.setParam(p.name, beyond), /GMPU_ERROR_INVALID_ARGUMENT/, p.name);
+        }
         // maxMemory's default depends on the machine: half its physical memory.
-        assert.match(body, /Default half the physical memory[^\n]*\n\s*maxMemory\?:/);
         const half = os.totalmem() / 2;
         assert.ok(Math.abs(actual.maxMemory - half) <= 0.01 * half, `maxMemory ${actual.maxMemory}, half of ${os.totalmem()}`);
-        assert.equal(documented.length, gmpu.parameterNames.length - 1, 'one "Default" per parameter');
-        for (const [, text, name] of documented) {
-            const value = text === 'false' ? 0 : text === 'true' ? 1 : Number(text.replace(/\.$/, ''));
-            assert.equal(value, actual[name], `${name}: index.d.ts says Default ${text}, the library has ${actual[name]}`);
-        }
     } finally {
         s.close();
     }

@@ -1,4 +1,5 @@
-"""The cffi cdef is generated from include/gmpu/gmpu.h: these tests fail when they drift."""
+"""The cffi cdef and the ABI summary (bindings/abi.txt, read by the Rust and Node tests) are
+generated from include/gmpu/gmpu.h: these tests fail when they drift."""
 import importlib.util
 import re
 
@@ -32,6 +33,29 @@ def test_checked_in_cdef_matches_the_header():
     assert actual == expected, (
         "bindings/python/gmpu/_cdef.py is out of date with include/gmpu/gmpu.h: "
         "run /usr/bin/python3 bindings/python/tools/generate_cdef.py")
+
+
+def test_checked_in_summary_matches_the_header():
+    gen = _generator()
+    expected = gen.generate_summary(gen.generate_cdef(header_text()))
+    actual = (REPO / "bindings" / "abi.txt").read_text(encoding="utf-8")
+    assert actual == expected, (
+        "bindings/abi.txt is out of date with include/gmpu/gmpu.h: "
+        "run /usr/bin/python3 bindings/python/tools/generate_cdef.py")
+
+
+def test_summary_has_every_declaration():
+    gen = _generator()
+    summary = gen.generate_summary(_cdef.CDEF)
+    kinds = [line.split("\t")[0] for line in summary.splitlines() if not line.startswith("#")]
+    names = re.findall(r"GMPU_API\s+[^;(]*?\b(gmpu_\w+)\s*\(", header_text())
+    assert kinds.count("fn") == len(names)
+    assert kinds.count("opaque") == 3 and kinds.count("callback") == 1 and kinds.count("define") == 5
+    assert "fn\tgmpu_surface_set_points_f32\tgmpu_status\tsurface:gmpu_surface *\txyz:const float *\t" \
+           "count:size_t\tstride:size_t" in summary
+    assert "field\tgmpu_param_info_t\tdoc\tconst char *" in summary
+    changed = _cdef.CDEF.replace("double *value);", "float *value);", 1)
+    assert gen.generate_summary(changed) != summary
 
 
 def test_drift_is_detected():

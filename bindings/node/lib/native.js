@@ -66,6 +66,17 @@ function declare(lib) {
     const progressProto = koffi.proto('int', ['void *', 'int', 'double']);
     const f = (ret, name, args) => lib.func(name, ret, args);
     const outPtr = koffi.out(koffi.pointer('void *'));
+    const paramInfo = koffi.struct({
+        name: 'const char *',
+        type: 'int',
+        default_value: 'double',
+        min: 'double',
+        max: 'double',
+        min_exclusive: 'int',
+        max_exclusive: 'int',
+        refits: 'int',
+        doc: 'const char *',
+    });
     return {
         progressType: koffi.pointer(progressProto),
 
@@ -74,6 +85,11 @@ function declare(lib) {
         version_number: f('uint32_t', 'gmpu_version_number', []),
         version_string: f('const char *', 'gmpu_version_string', []),
         abi_version: f('uint32_t', 'gmpu_abi_version', []),
+
+        TYPE_INT: 1, // gmpu_value_type
+        param_count: f('int', 'gmpu_param_count', []),
+        param_info: f('int', 'gmpu_param_info', ['int', koffi.out(koffi.pointer(paramInfo))]),
+        param_key: f('int', 'gmpu_param_key', ['const char *']),
 
         surface_create: f('int', 'gmpu_surface_create', [outPtr]),
         surface_destroy: f('void', 'gmpu_surface_destroy', ['void *']),

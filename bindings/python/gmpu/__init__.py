@@ -21,14 +21,15 @@ from ._errors import (BusyError, CancelledError, DegenerateInputError, Error, In
                       InvalidInputError, IoError, LimitExceededError, OutOfMemoryError, ParseError,
                       UnsupportedError, WrongOrderError)
 from ._progress import ProgressFn, Stage
-from ._core import PARAMS, STATS, Mesh, Points, Surface, read_points, reconstruct
+from ._params import ParamInfo
+from ._core import PARAM_INFO, PARAMS, STATS, Mesh, Points, Surface, read_points, reconstruct
 
 __version__ = library_version
 #: ABI version of the loaded library (the SONAME number).
 abi_version = int(_lib.gmpu_abi_version())
 
 __all__ = [
-    "reconstruct", "Surface", "Mesh", "Points", "read_points", "Stage", "ProgressFn", "PARAMS", "STATS",
+    "reconstruct", "Surface", "Mesh", "Points", "read_points", "Stage", "ProgressFn", "PARAMS", "PARAM_INFO", "ParamInfo", "STATS",
     "Error", "InvalidArgumentError", "InvalidInputError", "DegenerateInputError", "WrongOrderError",
     "OutOfMemoryError", "LimitExceededError", "CancelledError", "IoError", "ParseError", "UnsupportedError",
     "InternalError", "BusyError", "LibraryNotFoundError", "library_path", "library_version", "abi_version", "__version__",

@@ -13,9 +13,10 @@ from numpy.typing import ArrayLike, NDArray
 from ._arrays import _as_real_array, double_ptr, queries_for_c, uint32_ptr, view_of_c_memory, xyz_for_c
 from ._errors import check
 from ._library import ffi, lib
+from ._params import PARAM_INFO, PARAMS, param_value
 from ._progress import ProgressFn, run_with_progress
 
-__all__ = ["Surface", "Mesh", "Points", "reconstruct", "read_points", "PARAMS", "STATS"]
+__all__ = ["Surface", "Mesh", "Points", "reconstruct", "read_points", "PARAMS", "PARAM_INFO", "STATS"]
 
 PathLike = Union[str, "os.PathLike[str]"]
 
@@ -25,17 +26,11 @@ def _enum_names(ctype: str, prefix: str) -> Dict[str, int]:
     return {name[len(prefix):].lower(): value for name, value in sorted(items.items(), key=lambda kv: kv[1])}
 
 
-#: Parameter names (keyword arguments of Surface and reconstruct) → gmpu_param values, taken
-#: from the header, so a parameter added to the C library appears here by itself.
-PARAMS: Dict[str, int] = _enum_names("gmpu_param", "GMPU_PARAM_")
 #: Statistic names (keys of Surface.stats) → gmpu_stat values.
 STATS: Dict[str, int] = _enum_names("gmpu_stat", "GMPU_STAT_")
 
 _EVAL_CHUNK = 1 << 16  # query points per gmpu_surface_evaluate call
 
-_INT_PARAMS = {"max_depth", "min_points", "resolution", "level", "threads", "max_cells", "max_triangles",
-               "max_memory"}
-_BOOL_PARAMS = {"sharp_features"}
 _FLOAT_STATS = {"fit_seconds", "orient_seconds", "polygonize_seconds", "bbox_diagonal", "noise",
                 "effective_error"}
 
@@ -50,14 +45,6 @@ def _param_key(name: str) -> int:
 def _param_number(name: str, value: Any) -> float:
     if isinstance(value, (str, bytes)) or not isinstance(value, (numbers.Real, np.number)):
         raise TypeError(f"gmpu parameter {name!r} must be a number, got {type(value).__name__}")
-    return float(value)
-
-
-def _param_value(name: str, value: float) -> Union[int, float, bool]:
-    if name in _BOOL_PARAMS:
-        return bool(value)
-    if name in _INT_PARAMS and float(value).is_integer():
-        return int(value)
     return float(value)
 
 
@@ -429,7 +416,7 @@ class Surface:
         key = _param_key(name)
         value = ffi.new("double *")
         self._read(lambda s: check(lib.gmpu_surface_get_param(s, key, value), "gmpu_surface_get_param"))
-        return _param_value(name, value[0])
+        return param_value(name, value[0])
 
     @property
     def params(self) -> Dict[str, Union[int, float, bool]]:

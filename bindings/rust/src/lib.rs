@@ -58,7 +58,8 @@
 //! returned (the surface stays valid and keeps the stages completed before).
 //!
 //! # Linking
-//! `build.rs` links `libgmpu` from `GMPU_LIB_DIR`, else `pkg-config --libs gmpu`, else
+//! `build.rs` links `libgmpu` from `GMPU_LIBRARY` (the library's path, as for the other
+//! bindings), else `pkg-config --libs gmpu`, else
 //! this source tree's meson build (`../../build/lib`), and sets an rpath to it for the
 //! crate's own tests and examples.
 #![warn(missing_docs)]
@@ -68,7 +69,7 @@ pub mod sys;
 use std::any::Any;
 use std::ffi::{CStr, CString};
 use std::fmt;
-use std::os::raw::{c_int, c_void};
+use std::os::raw::{c_char, c_int, c_void};
 use std::panic::{self, AssertUnwindSafe};
 use std::path::Path;
 use std::ptr::{self, NonNull};
@@ -268,25 +269,24 @@ macro_rules! key_enum {
 }
 
 key_enum! {
-    /// A parameter of [`Surface::set_param`] (`gmpu_param`); see the header for ranges.
+    /// A parameter of [`Surface::set_param`] (`gmpu_param`). Its name, default, range and
+    /// doc are the library's: [`Param::info`].
     Param: sys::gmpu_param {
-        /// ε, the largest fit error allowed, as a fraction of the bounding-box diagonal
-        /// (default 0.002, range (0, 1)). Discards a previous fit.
+        /// ε, the largest fit error allowed, as a fraction of the bounding-box diagonal.
         Error = sys::GMPU_PARAM_ERROR,
-        /// Deepest octree level (default 10, range 1..16). Discards a previous fit.
+        /// Deepest octree level.
         MaxDepth = sys::GMPU_PARAM_MAX_DEPTH,
-        /// Fewest points a local fit uses (default 15, range 6..1000). Discards a previous fit.
+        /// Fewest points a local fit uses.
         MinPoints = sys::GMPU_PARAM_MIN_POINTS,
-        /// α: support radius = α × cell diagonal (default 0.75, range [0.5, 2]).
+        /// α: support radius = α × cell diagonal.
         SupportScale = sys::GMPU_PARAM_SUPPORT_SCALE,
-        /// 1: piecewise quadrics where a small cell straddles a sharp edge or corner;
-        /// 0 (default): smooth models only. Discards a previous fit.
+        /// 1: piecewise quadrics where a small cell straddles a sharp edge or corner.
         SharpFeatures = sys::GMPU_PARAM_SHARP_FEATURES,
-        /// Polygonize grid cubes along the longest side; 0 (default) picks one; else 8..4096.
+        /// Polygonize grid cubes along the longest side; 0 picks one from the octree.
         Resolution = sys::GMPU_PARAM_RESOLUTION,
-        /// Level of detail for evaluate and polygonize; 0 (default) uses every level.
+        /// Level of detail for evaluate and polygonize; 0 uses every level.
         Level = sys::GMPU_PARAM_LEVEL,
-        /// Worker threads for fit, orient and polygonize; 0 (default) uses every core.
+        /// Worker threads for fit, orient and polygonize; 0 uses every core.
         Threads = sys::GMPU_PARAM_THREADS,
         /// Fit fails with [`Status::LimitExceeded`] instead of making more cells than this.
         MaxCells = sys::GMPU_PARAM_MAX_CELLS,
@@ -295,8 +295,90 @@ key_enum! {
         /// Noise floor for ε: fit works to max(Error, NoiseScale × estimated noise).
         NoiseScale = sys::GMPU_PARAM_NOISE_SCALE,
         /// Memory budget in bytes: fit and polygonize fail with [`Status::LimitExceeded`]
-        /// when their estimated peak exceeds it. Default: half the physical memory.
+        /// when their estimated peak exceeds it.
         MaxMemory = sys::GMPU_PARAM_MAX_MEMORY,
+    }
+}
+
+/// One row of the library's parameter table (`gmpu_param_info`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParamInfo {
+    /// The raw `gmpu_param` key (1..=[`param_count`]).
+    pub key: u32,
+    /// The library's name (`"max_depth"`).
+    pub name: &'static str,
+    /// Only whole numbers are accepted.
+    pub integer: bool,
+    /// A new surface's value.
+    pub default: f64,
+    /// Smallest accepted value (refused itself when `min_exclusive`).
+    pub min: f64,
+    /// Largest accepted value (refused itself when `max_exclusive`).
+    pub max: f64,
+    /// `min` itself is refused.
+    pub min_exclusive: bool,
+    /// `max` itself is refused.
+    pub max_exclusive: bool,
+    /// Changing the value discards a previous fit.
+    pub refits: bool,
+    /// One line: what the parameter does.
+    pub doc: &'static str,
+}
+
+fn static_str(p: *const c_char) -> &'static str {
+    // SAFETY: the library's parameter strings are NUL-terminated static storage.
+    unsafe { CStr::from_ptr(p) }.to_str().unwrap_or("")
+}
+
+/// Number of parameter keys the library has: they are `1..=param_count()`.
+pub fn param_count() -> u32 {
+    // SAFETY: no arguments, no state.
+    u32::try_from(unsafe { sys::gmpu_param_count() }).unwrap_or(0)
+}
+
+/// The library's description of a raw key (also of keys newer than this binding's [`Param`]).
+pub fn param_info(key: u32) -> Result<ParamInfo> {
+    let mut raw = std::mem::MaybeUninit::<sys::gmpu_param_info_t>::zeroed();
+    // SAFETY: valid out pointer; unknown keys are refused with a status.
+    check(unsafe { sys::gmpu_param_info(key, raw.as_mut_ptr()) })?;
+    // SAFETY: filled by the successful call above.
+    let raw = unsafe { raw.assume_init() };
+    Ok(ParamInfo {
+        key,
+        name: static_str(raw.name),
+        integer: raw.type_ == sys::GMPU_TYPE_INT,
+        default: raw.default_value,
+        min: raw.min,
+        max: raw.max,
+        min_exclusive: raw.min_exclusive != 0,
+        max_exclusive: raw.max_exclusive != 0,
+        refits: raw.refits != 0,
+        doc: static_str(raw.doc),
+    })
+}
+
+/// Every parameter the library has, in key order.
+pub fn param_table() -> Vec<ParamInfo> {
+    (1..=param_count()).filter_map(|key| param_info(key).ok()).collect()
+}
+
+impl Param {
+    /// The library's description of this parameter.
+    pub fn info(self) -> ParamInfo {
+        param_info(self.to_raw()).expect("every Param variant is a key of the library it links")
+    }
+
+    /// The library's name of this parameter (`"max_depth"`).
+    pub fn name(self) -> &'static str {
+        self.info().name
+    }
+
+    /// The parameter the library calls `name` (`"max_depth"` or `"GMPU_PARAM_MAX_DEPTH"`).
+    pub fn from_name(name: &str) -> Option<Param> {
+        let c = CString::new(name).ok()?;
+        // SAFETY: NUL-terminated string, read only during the call.
+        let key = unsafe { sys::gmpu_param_key(c.as_ptr()) };
+        Param::from_raw(u32::try_from(key).ok()?)
     }
 }
 

@@ -3,7 +3,8 @@
 //! Everything here is `unsafe` and follows the header's rules (ownership, NULL handling,
 //! thread safety); the safe API is in the crate root. The declarations are written through
 //! two macros that also record them as data ([`FUNCTIONS`], [`ENUMS`], [`OPAQUE_TYPES`],
-//! [`DEFINES`]); the test `tests/header_sync.rs` parses the header and fails when the two
+//! [`DEFINES`]); the test `tests/header_sync.rs` compares them with `bindings/abi.txt` (the
+//! summary generated from the header) and fails when the two
 //! drift apart (a function, parameter type, return type or enum value added, removed or
 //! changed on either side).
 //!
@@ -72,9 +73,9 @@ macro_rules! c_functions {
 
 /// `#define`d integer constants of the header.
 pub const GMPU_VERSION_MAJOR: u32 = 0;
-pub const GMPU_VERSION_MINOR: u32 = 2;
+pub const GMPU_VERSION_MINOR: u32 = 3;
 pub const GMPU_VERSION_PATCH: u32 = 0;
-pub const GMPU_VERSION_NUMBER: u32 = 200;
+pub const GMPU_VERSION_NUMBER: u32 = 300;
 pub const GMPU_ABI_VERSION: u32 = 1;
 pub const DEFINES: &[(&str, u32)] = &[
     ("GMPU_VERSION_MAJOR", GMPU_VERSION_MAJOR),
@@ -135,6 +136,10 @@ c_enums! {
         GMPU_PARAM_NOISE_SCALE = 11,
         GMPU_PARAM_MAX_MEMORY = 12,
     }
+    gmpu_value_type {
+        GMPU_TYPE_INT = 1,
+        GMPU_TYPE_REAL = 2,
+    }
     gmpu_stage {
         GMPU_STAGE_FIT = 1,
         GMPU_STAGE_ORIENT = 2,
@@ -161,6 +166,22 @@ c_enums! {
     }
 }
 
+/// One row of the library's parameter table (`gmpu_param_info_t`); the strings are the
+/// library's, in static storage.
+#[repr(C)]
+#[derive(Debug, Clone, Copy)]
+pub struct gmpu_param_info_t {
+    pub name: *const c_char,
+    pub type_: gmpu_value_type,
+    pub default_value: f64,
+    pub min: f64,
+    pub max: f64,
+    pub min_exclusive: c_int,
+    pub max_exclusive: c_int,
+    pub refits: c_int,
+    pub doc: *const c_char,
+}
+
 /// `typedef int (*gmpu_progress_fn)(void *user, gmpu_stage stage, double fraction);`
 /// (nullable, hence the `Option`).
 pub type gmpu_progress_fn = Option<unsafe extern "C" fn(user: *mut c_void, stage: gmpu_stage, fraction: f64) -> c_int>;
@@ -175,6 +196,10 @@ c_functions! {
     pub fn gmpu_version_number() -> u32;
     pub fn gmpu_version_string() -> *const c_char;
     pub fn gmpu_abi_version() -> u32;
+
+    pub fn gmpu_param_count() -> c_int;
+    pub fn gmpu_param_info(key: gmpu_param, info: *mut gmpu_param_info_t) -> gmpu_status;
+    pub fn gmpu_param_key(name: *const c_char) -> c_int;
 
     pub fn gmpu_surface_create(out: *mut *mut gmpu_surface) -> gmpu_status;
     pub fn gmpu_surface_destroy(surface: *mut gmpu_surface);

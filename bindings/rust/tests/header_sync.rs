@@ -1,81 +1,40 @@
-//! Keeps `gmpu::sys` (and the safe enums) in sync with `include/gmpu/gmpu.h`: the header's
-//! function prototypes, the progress-callback typedef, the opaque handles, the enum values
-//! and the version defines are parsed and compared with what `sys` declares. Any function,
-//! parameter (type or name), return type, enumerator or value that differs fails the test.
-//! The header is `../../include/gmpu/gmpu.h`, or `GMPU_HEADER` if set.
+//! Keeps `gmpu::sys` (and the safe enums) in sync with `include/gmpu/gmpu.h`, through the
+//! ABI summary `bindings/abi.txt` that `bindings/python/tools/generate_cdef.py` generates
+//! from the header (the Python tests fail when the summary is stale): its function
+//! prototypes, the progress-callback typedef, the opaque handles, the struct fields, the
+//! enum values and the version defines are compared with what `sys` declares. Any
+//! function, parameter (type or name), return type, field, enumerator or value that differs
+//! fails the test. The summary is `../abi.txt`, or `GMPU_ABI_SUMMARY` if set.
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
 use gmpu::sys;
 
-fn header_path() -> PathBuf {
-    match std::env::var_os("GMPU_HEADER") {
+fn summary_path() -> PathBuf {
+    match std::env::var_os("GMPU_ABI_SUMMARY") {
         Some(p) => PathBuf::from(p),
-        None => PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../include/gmpu/gmpu.h"),
+        None => PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../abi.txt"),
     }
 }
 
-fn header_text() -> String {
-    let path = header_path();
-    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("cannot read the C header {}: {e}", path.display()))
+fn summary_text() -> String {
+    let path = summary_path();
+    std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("cannot read the ABI summary {}: {e}", path.display()))
 }
-
-// ---- a small parser for the subset of C the header uses ----------------------------------
 
 #[derive(Debug, Default)]
 struct Header {
     functions: BTreeMap<String, (Vec<(String, String)>, String)>, // name → ([(param, rust type)], rust ret)
     enums: BTreeMap<String, Vec<(String, u32)>>,
     opaque: Vec<String>,
+    structs: BTreeMap<String, Vec<(String, String)>>, // name → [(field, rust type)]
     progress_fn: Option<(Vec<String>, String)>,
     defines: BTreeMap<String, u32>,
 }
 
-fn strip_comments(text: &str) -> String {
-    let mut out = String::with_capacity(text.len());
-    let mut rest = text;
-    loop {
-        let block = rest.find("/*");
-        let line = rest.find("//");
-        match (block, line) {
-            (Some(b), l) if l.map_or(true, |l| b < l) => {
-                out.push_str(&rest[..b]);
-                let end = rest[b + 2..].find("*/").expect("unterminated comment in header");
-                out.push(' ');
-                rest = &rest[b + 2 + end + 2..];
-            }
-            (_, Some(l)) => {
-                out.push_str(&rest[..l]);
-                rest = &rest[l..];
-                rest = rest.find('\n').map_or("", |n| &rest[n..]);
-            }
-            _ => {
-                out.push_str(rest);
-                return out;
-            }
-        }
-    }
-}
-
-fn tokens(text: &str) -> Vec<String> {
-    let mut out = Vec::new();
-    let mut word = String::new();
-    for c in text.chars() {
-        if c.is_alphanumeric() || c == '_' {
-            word.push(c);
-        } else {
-            if !word.is_empty() {
-                out.push(std::mem::take(&mut word));
-            }
-            if !c.is_whitespace() {
-                out.push(c.to_string());
-            }
-        }
-    }
-    if !word.is_empty() {
-        out.push(word);
-    }
-    out
+/// The tokens of a C type as the summary spells it (`gmpu_surface **` → gmpu_surface * *).
+fn c_tokens(c: &str) -> Vec<String> {
+    c.replace('*', " * ").split_whitespace().map(String::from).collect()
 }
 
 /// The Rust spelling of a C type given as tokens (`const double *` → `*const f64`).
@@ -124,84 +83,41 @@ fn rust_type(c: &[String]) -> String {
     ty
 }
 
-/// `(name, rust type)` of each parameter in a C parameter list's tokens.
-fn params(list: &[String]) -> Vec<(String, String)> {
-    if list.is_empty() || (list.len() == 1 && list[0] == "void") {
-        return Vec::new();
-    }
-    list.split(|t| t == ",")
-        .map(|p| {
-            let (name, ty) = p.split_last().unwrap_or_else(|| panic!("empty parameter in {list:?}"));
-            assert!(!ty.is_empty(), "unnamed parameter {p:?}: name every parameter in the header");
-            (name.clone(), rust_type(ty))
+/// `(name, rust type)` of each `name:C type` field of a summary line.
+fn params(fields: &[&str]) -> Vec<(String, String)> {
+    fields
+        .iter()
+        .map(|f| {
+            let (name, ty) = f.split_once(':').unwrap_or_else(|| panic!("parameter {f:?} is not name:type"));
+            (name.to_string(), rust_type(&c_tokens(ty)))
         })
         .collect()
 }
 
-fn parse_header(text: &str) -> Header {
-    let text = strip_comments(text);
+fn parse_summary(text: &str) -> Header {
     let mut h = Header::default();
-    let mut code = String::new();
-    for line in text.lines() {
-        let t = line.trim_start();
-        if let Some(rest) = t.strip_prefix("#") {
-            let w: Vec<&str> = rest.split_whitespace().collect();
-            if w.len() == 3 && w[0] == "define" {
-                if let Ok(v) = w[2].parse::<u32>() {
-                    h.defines.insert(w[1].to_string(), v);
-                }
+    for line in text.lines().filter(|l| !l.starts_with('#') && !l.is_empty()) {
+        let f: Vec<&str> = line.split('\t').collect();
+        let value = |s: &str| s.parse::<u32>().unwrap_or_else(|_| panic!("not a number in {line:?}"));
+        match f.as_slice() {
+            ["define", name, v] => {
+                h.defines.insert(name.to_string(), value(v));
             }
-        } else {
-            code.push_str(line);
-            code.push('\n');
-        }
-    }
-    let t = tokens(&code);
-    let mut i = 0;
-    while i < t.len() {
-        if t[i] == "GMPU_API" {
-            let end = i + t[i..].iter().position(|x| x == ";").expect("prototype without ;");
-            let proto = &t[i + 1..end];
-            let open = proto.iter().position(|x| x == "(").expect("prototype without (");
-            assert_eq!(proto.last().map(String::as_str), Some(")"), "prototype {proto:?}");
-            let name = proto[open - 1].clone();
-            let ret = rust_type(&proto[..open - 1]);
-            let ps = params(&proto[open + 1..proto.len() - 1]);
-            assert!(h.functions.insert(name.clone(), (ps, ret)).is_none(), "{name} declared twice");
-            i = end;
-        } else if t[i] == "typedef" && t.get(i + 1).map(String::as_str) == Some("enum") {
-            let open = i + t[i..].iter().position(|x| x == "{").unwrap();
-            let close = open + t[open..].iter().position(|x| x == "}").unwrap();
-            let name = t[close + 1].clone();
-            let mut values = Vec::new();
-            let mut next = 0u32;
-            for item in t[open + 1..close].split(|x| x == ",").filter(|x| !x.is_empty()) {
-                let value = match item {
-                    [_] => next,
-                    [_, eq, v] if eq == "=" => v.parse().unwrap_or_else(|_| panic!("enum value {item:?}")),
-                    _ => panic!("cannot parse enumerator {item:?}"),
-                };
-                values.push((item[0].clone(), value));
-                next = value + 1;
+            ["opaque", name] => h.opaque.push(name.to_string()),
+            ["enum", ty, name, v] => h.enums.entry(ty.to_string()).or_default().push((name.to_string(), value(v))),
+            ["field", ty, name, c] => {
+                h.structs.entry(ty.to_string()).or_default().push((name.to_string(), rust_type(&c_tokens(c))))
             }
-            h.enums.insert(name, values);
-            i = close;
-        } else if t[i] == "typedef" && t.get(i + 1).map(String::as_str) == Some("struct") {
-            h.opaque.push(t[i + 2].clone());
-            i += 3;
-        } else if t[i] == "typedef" && t.get(i + 1).map(String::as_str) != Some("enum") {
-            // typedef RET (*NAME)(PARAMS);
-            let end = i + t[i..].iter().position(|x| x == ";").unwrap();
-            let td = &t[i + 1..end];
-            let star = td.iter().position(|x| x == "*").unwrap_or_else(|| panic!("typedef {td:?}"));
-            let name = td[star + 1].clone();
-            assert_eq!(name, "gmpu_progress_fn", "new function-pointer typedef {name}: add it to sys");
-            let ret = rust_type(&td[..star - 1]);
-            let ps = params(&td[star + 4..td.len() - 1]);
-            h.progress_fn = Some((ps.into_iter().map(|(_, ty)| ty).collect(), ret));
-            i = end;
+            ["fn", name, ret, ps @ ..] => {
+                let entry = (params(ps), rust_type(&c_tokens(ret)));
+                assert!(h.functions.insert(name.to_string(), entry).is_none(), "{name} declared twice");
+            }
+            ["callback", name, ret, ps @ ..] => {
+                assert_eq!(*name, "gmpu_progress_fn", "new function-pointer typedef {name}: add it to sys");
+                h.progress_fn = Some((params(ps).into_iter().map(|(_, ty)| ty).collect(), rust_type(&c_tokens(ret))));
+            }
+            _ => panic!("unknown summary line {line:?}"),
         }
-        i += 1;
     }
     h
 }
@@ -223,8 +139,8 @@ fn screaming(camel: &str) -> String {
 }
 
 /// Every difference between the header and the binding, in words.
-fn differences(header_text: &str) -> Vec<String> {
-    let h = parse_header(header_text);
+fn differences(summary: &str) -> Vec<String> {
+    let h = parse_summary(summary);
     let mut diffs = Vec::new();
 
     // Functions, both ways.
@@ -303,6 +219,25 @@ fn differences(header_text: &str) -> Vec<String> {
         diffs.push(format!("opaque handles: header {ho:?}, sys {so:?}"));
     }
 
+    // Struct fields, in order, from sys.rs's `pub struct NAME { pub field: type, ... }`.
+    for (name, fields) in &h.structs {
+        let Some(at) = src.find(&format!("pub struct {name} {{")) else {
+            diffs.push(format!("struct {name} is in the header but not in sys"));
+            continue;
+        };
+        let body = &src[at..at + src[at..].find('}').unwrap()];
+        let sys_fields: Vec<(String, String)> = body
+            .lines()
+            .filter_map(|l| l.trim().strip_prefix("pub "))
+            .filter_map(|l| l.trim_end_matches(',').split_once(':'))
+            .map(|(n, t)| (n.trim().trim_end_matches('_').to_string(), norm(t)))
+            .collect();
+        let want: Vec<(String, String)> = fields.iter().map(|(n, t)| (n.clone(), norm(t))).collect();
+        if sys_fields != want {
+            diffs.push(format!("struct {name}: header {want:?}, sys {sys_fields:?}"));
+        }
+    }
+
     // Enums, both ways, with values.
     let sys_enums: BTreeMap<&str, &sys::EnumDecl> = sys::ENUMS.iter().map(|e| (e.name, e)).collect();
     for (name, values) in &h.enums {
@@ -374,8 +309,8 @@ fn differences(header_text: &str) -> Vec<String> {
 
 #[test]
 fn sys_matches_header() {
-    let diffs = differences(&header_text());
-    assert!(diffs.is_empty(), "gmpu::sys differs from {}:\n  {}", header_path().display(), diffs.join("\n  "));
+    let diffs = differences(&summary_text());
+    assert!(diffs.is_empty(), "gmpu::sys differs from {}:\n  {}", summary_path().display(), diffs.join("\n  "));
 }
 
 /// Every declared function resolves in the library this crate links (taking the addresses
@@ -390,10 +325,10 @@ fn library_exports_every_declared_function() {
 }
 
 #[test]
-fn parser_sees_the_whole_header() {
-    let h = parse_header(&header_text());
-    assert!(h.functions.len() >= 37, "only {} prototypes parsed", h.functions.len());
-    assert_eq!(h.enums.len(), 4, "{:?}", h.enums.keys());
+fn summary_holds_the_whole_header() {
+    let h = parse_summary(&summary_text());
+    assert!(h.functions.len() >= 40, "only {} prototypes in the summary", h.functions.len());
+    assert_eq!(h.enums.len(), 5, "{:?}", h.enums.keys());
     assert_eq!(h.functions["gmpu_surface_set_points_f32"].0[1], ("xyz".into(), "*const f32".into()));
     assert_eq!(h.functions["gmpu_surface_create"].0[0].1, "*mut *mut gmpu_surface");
     assert_eq!(h.functions["gmpu_surface_destroy"].1, "()");
@@ -403,36 +338,32 @@ fn parser_sees_the_whole_header() {
 /// sys does not have, and must be reported.
 #[test]
 fn drift_is_detected() {
-    let text = header_text();
+    let text = summary_text();
     let edits: &[(&str, &str)] = &[
-        ("GMPU_PARAM_NOISE_SCALE = 11", "GMPU_PARAM_NOISE_SCALE = 12"),
-        ("GMPU_PARAM_NOISE_SCALE = 11", "GMPU_PARAM_NOISE_SCALE = 11,\n    GMPU_PARAM_NEW = 12"),
-        ("GMPU_STAGE_POLYGONIZE = 3", "GMPU_STAGE_POLYGONIZE = 3, GMPU_STAGE_EXTRA = 4"),
-        ("GMPU_ERROR_INTERNAL = 11", "GMPU_ERROR_INTERNAL = 11, GMPU_ERROR_NEW = 12"),
+        ("GMPU_PARAM_NOISE_SCALE\t11", "GMPU_PARAM_NOISE_SCALE\t12"),
+        ("GMPU_PARAM_MAX_MEMORY\t12\n", "GMPU_PARAM_MAX_MEMORY\t12\nenum\tgmpu_param\tGMPU_PARAM_NEW\t13\n"),
+        ("GMPU_STAGE_POLYGONIZE\t3\n", "GMPU_STAGE_POLYGONIZE\t3\nenum\tgmpu_stage\tGMPU_STAGE_EXTRA\t4\n"),
+        ("GMPU_ERROR_BUSY\t12\n", "GMPU_ERROR_BUSY\t12\nenum\tgmpu_status\tGMPU_ERROR_NEW\t13\n"),
         (
-            "const double *xyz,\n                                                 size_t count",
-            "const float *xyz,\n                                                 size_t count",
+            "gmpu_surface_set_points_f64\tgmpu_status\tsurface:gmpu_surface *\txyz:const double *",
+            "gmpu_surface_set_points_f64\tgmpu_status\tsurface:gmpu_surface *\txyz:const float *",
         ),
-        ("gmpu_surface_point_count(const gmpu_surface *surface)", "gmpu_surface_point_count(gmpu_surface *surface)"),
-        ("GMPU_API uint32_t gmpu_abi_version(void);", "GMPU_API uint64_t gmpu_abi_version(void);"),
         (
-            "GMPU_API uint32_t gmpu_abi_version(void);",
-            "GMPU_API uint32_t gmpu_abi_version(void);\nGMPU_API int gmpu_new(void);",
+            "gmpu_surface_point_count\tsize_t\tsurface:const gmpu_surface *",
+            "gmpu_surface_point_count\tsize_t\tsurface:gmpu_surface *",
         ),
-        ("GMPU_API uint32_t gmpu_abi_version(void);", ""),
-        (
-            "size_t count, size_t stride);\nGMPU_API gmpu_status gmpu_surface_set_points_f32",
-            "size_t stride, size_t count);\nGMPU_API gmpu_status gmpu_surface_set_points_f32",
-        ),
-        ("(void *user, gmpu_stage stage, double fraction)", "(void *user, gmpu_stage stage, float fraction)"),
-        (
-            "typedef struct gmpu_points gmpu_points;",
-            "typedef struct gmpu_points gmpu_points;\ntypedef struct gmpu_octree gmpu_octree;",
-        ),
-        ("#define GMPU_ABI_VERSION 1", "#define GMPU_ABI_VERSION 2"),
+        ("fn\tgmpu_abi_version\tuint32_t", "fn\tgmpu_abi_version\tuint64_t"),
+        ("fn\tgmpu_abi_version\tuint32_t\n", "fn\tgmpu_abi_version\tuint32_t\nfn\tgmpu_new\tint\n"),
+        ("fn\tgmpu_abi_version\tuint32_t\n", ""),
+        ("xyz:const double *\tcount:size_t\tstride:size_t", "xyz:const double *\tstride:size_t\tcount:size_t"),
+        ("fraction:double", "fraction:float"),
+        ("opaque\tgmpu_points\n", "opaque\tgmpu_points\nopaque\tgmpu_octree\n"),
+        ("GMPU_ABI_VERSION\t1", "GMPU_ABI_VERSION\t2"),
+        ("field\tgmpu_param_info_t\tmin\tdouble", "field\tgmpu_param_info_t\tmin\tfloat"),
+        ("field\tgmpu_param_info_t\trefits\tint\n", ""),
     ];
     for (from, to) in edits {
-        assert!(text.contains(from), "the header no longer contains {from:?}: update this test");
+        assert!(text.contains(from), "the summary no longer contains {from:?}: update this test");
         let diffs = differences(&text.replacen(from, to, 1));
         assert!(!diffs.is_empty(), "changing {from:?} to {to:?} went unnoticed");
     }
