@@ -87,6 +87,8 @@ export interface Parameters {
     noiseScale?: number;
     /** Memory budget in bytes: fit and polygonize fail (GMPU_ERROR_LIMIT_EXCEEDED) when their estimated peak exceeds it. Default half the physical memory; 1e6..1e15. */
     maxMemory?: number;
+    /** 1: set_points leaves the outliers it finds out of the fit; 0: fits them too (GMPU_STAT_OUTLIERS counts them either way). Default 1, 0..1. */
+    removeOutliers?: boolean | number;
 }
 export type ParameterName = keyof Parameters;
 export declare const parameterNames: readonly ParameterName[];

@@ -80,6 +80,7 @@ const PARAMS = Object.freeze({
     maxTriangles: 10,
     noiseScale: 11,
     maxMemory: 12,
+    removeOutliers: 13,
 });
 
 const STATS = Object.freeze({

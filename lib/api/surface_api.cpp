@@ -14,12 +14,14 @@
 
 #include "api/guard.hpp"
 #include "api/handles.hpp"
+#include "api/surface_parts.hpp"
 #include "core/parallel.hpp"
 #include "core/params.hpp"
 #include "core/progress.hpp"
 #include "core/release_memory.hpp"
 #include "fit/build_octree.hpp"
 #include "fit/noise_estimate.hpp"
+#include "geometry/clusters.hpp"
 #include "geometry/outliers.hpp"
 #include "geometry/point_set.hpp"
 #include "implicit/mpu_function.hpp"
@@ -27,6 +29,7 @@
 #include "implicit/winding_field.hpp"
 #include "mesh/polygonizer.hpp"
 #include "orient/orient.hpp"
+#include "orient/orient_memory.hpp"
 
 using gmpu::Error;
 using gmpu::api::guarded;
@@ -44,6 +47,9 @@ struct gmpu_surface {
     gmpu::Octree tree;
     gmpu::PointMeasures measures;      // oriented normals, areas, trust radii per point
     gmpu::WindingField winding;        // built from the measures; signs far regions
+    // Set when the points are spatially separated clusters: then each is a surface of its
+    // own, and points, tree, measures and winding above stay empty.
+    std::unique_ptr<gmpu::api::SurfaceParts> parts;
     gmpu_progress_fn progress_fn = nullptr;
     void *progress_user = nullptr;
     std::string last_error;
@@ -145,7 +151,7 @@ struct ParamSpec {
 // Unknown keys are rejected as ints, before the enum is loaded (see enum_int).
 void check_key(const gmpu_param &key) {
     const int v = gmpu::api::enum_int(key);
-    if (v < GMPU_PARAM_ERROR || v > GMPU_PARAM_MAX_MEMORY)  // the first and the last key
+    if (v < GMPU_PARAM_ERROR || v > GMPU_PARAM_REMOVE_OUTLIERS)  // the first and the last key
         throw Error(GMPU_ERROR_INVALID_ARGUMENT, "unknown parameter key " + std::to_string(v));
 }
 void check_key(const gmpu_stat &key) {
@@ -168,6 +174,7 @@ ParamSpec spec(gmpu_param key) {
         case GMPU_PARAM_MAX_TRIANGLES: return {1, 2e9, true, false, "GMPU_PARAM_MAX_TRIANGLES"};
         case GMPU_PARAM_NOISE_SCALE: return {0, 20, false, true, "GMPU_PARAM_NOISE_SCALE"};
         case GMPU_PARAM_MAX_MEMORY: return {1e6, 1e15, true, false, "GMPU_PARAM_MAX_MEMORY"};
+        case GMPU_PARAM_REMOVE_OUTLIERS: return {0, 1, true, false, "GMPU_PARAM_REMOVE_OUTLIERS"};
     }
     throw Error(GMPU_ERROR_INVALID_ARGUMENT, "unknown parameter key " + std::to_string(int(key)));
 }
@@ -198,6 +205,7 @@ double get_param(const gmpu::Params &p, gmpu_param key) {
         case GMPU_PARAM_MAX_TRIANGLES: return p.max_triangles;
         case GMPU_PARAM_NOISE_SCALE: return p.noise_scale;
         case GMPU_PARAM_MAX_MEMORY: return p.max_memory;
+        case GMPU_PARAM_REMOVE_OUTLIERS: return p.remove_outliers ? 1 : 0;
     }
     throw Error(GMPU_ERROR_INVALID_ARGUMENT, "unknown parameter key " + std::to_string(int(key)));
 }
@@ -229,8 +237,15 @@ void set_param(gmpu::Params &p, gmpu_param key, double value) {
         case GMPU_PARAM_RESOLUTION: p.resolution = int(value); break;
         case GMPU_PARAM_LEVEL: p.level = int(value); break;
         case GMPU_PARAM_THREADS: p.threads = unsigned(value); break;
+        case GMPU_PARAM_REMOVE_OUTLIERS: p.remove_outliers = value != 0; break;
         default: break;
     }
+}
+
+// The clusters' surfaces take every parameter of their owner's.
+void push_params(const gmpu::Params &p, gmpu::api::SurfaceParts &parts) {
+    for (int key = GMPU_PARAM_ERROR; key <= GMPU_PARAM_REMOVE_OUTLIERS; ++key)
+        parts.set_param(gmpu_param(key), get_param(p, gmpu_param(key)));
 }
 
 void check_array(const void *data, size_t count, size_t stride, size_t element, const char *what) {
@@ -309,13 +324,34 @@ gmpu_status set_points(gmpu_surface *s, const T *xyz, size_t count, size_t strid
         check_array(xyz, count, stride, 3 * sizeof(T), "xyz");
         const size_t min_points = size_t(s->params.min_points);
         gmpu::OutlierScan scan = gmpu::find_outliers(xyz, count, stride);
+        const gmpu::Clusters groups = gmpu::find_clusters(xyz, count, stride, scan.outliers, min_points);
+        if (groups.count > 1) {
+            auto parts = std::make_unique<gmpu::api::SurfaceParts>(groups);
+            push_params(s->params, *parts);
+            parts->set_points(xyz, count, stride);
+            s->discard_fit();
+            s->points = gmpu::PointSet();
+            s->input_count = count;
+            s->outliers.clear();
+            s->outlier_nearest.clear();
+            s->input_normals.clear();
+            s->parts = std::move(parts);
+            s->stage = gmpu_surface::Stage::points;
+            return;
+        }
         // The points' own spacing, not their bounding box, is the scale of the detail: one
         // octree in float coordinates resolves about a millionth of the extent.
         if (scan.spacing > 0.0 && scan.spacing < 1e-6 * scan.extent) throw clusters(scan);
         std::vector<uint32_t> nearest;
-        gmpu::PointSet points = scan.outliers.empty() ? points_or_clusters(xyz, count, stride, min_points)
-                                                      : kept_points(xyz, count, stride, min_points, scan.outliers, nearest);
+        const bool set_aside = s->params.remove_outliers && !scan.outliers.empty();
+        gmpu::PointSet points = set_aside ? kept_points(xyz, count, stride, min_points, scan.outliers, nearest)
+                                          : points_or_clusters(xyz, count, stride, min_points);
+        if (!set_aside) {  // kept in the fit, but still reported
+            points.set_outlier_count(scan.outliers.size());
+            scan.outliers.clear();
+        }
         s->discard_fit();
+        s->parts.reset();
         s->points = std::move(points);
         s->input_count = count;
         s->outliers = std::move(scan.outliers);
@@ -335,6 +371,11 @@ gmpu_status set_normals(gmpu_surface *s, const T *nxyz, size_t count, size_t str
         if (count != s->input_count)
             throw Error(GMPU_ERROR_INVALID_INPUT, std::to_string(count) + " normals given for " +
                                                       std::to_string(s->input_count) + " points");
+        if (s->parts) {
+            s->parts->set_normals(nxyz, count, stride);
+            if (s->stage > gmpu_surface::Stage::fitted) s->stage = gmpu_surface::Stage::fitted;
+            return;
+        }
         if (stride == 0) stride = 3 * sizeof(T);
         std::vector<float> unit;
         unit.reserve(3 * s->points.size());
@@ -416,6 +457,11 @@ GMPU_API gmpu_status gmpu_surface_get_stat(const gmpu_surface *s, gmpu_stat key,
         require_arg(value, "value");
         s->require_idle("gmpu_surface_get_stat");
         check_key(key);
+        if (s->parts && key != GMPU_STAT_POINTS && key != GMPU_STAT_FIT_SECONDS && key != GMPU_STAT_ORIENT_SECONDS &&
+            key != GMPU_STAT_POLYGONIZE_SECONDS) {
+            *value = s->parts->stat(key);
+            return;
+        }
         const auto &cells = s->tree.cells;
         auto leaves_where = [&](auto pred) {
             double n = 0;
@@ -495,6 +541,15 @@ GMPU_API gmpu_status gmpu_surface_fit(gmpu_surface *s) {
         auto t0 = Clock::now();
         gmpu::Progress progress(s->progress_fn ? progress_or_stop : nullptr, s, GMPU_STAGE_FIT);
         progress.report(0.0, true);
+        if (s->parts) {
+            push_params(s->params, *s->parts);
+            s->parts->fit(progress_or_stop, s);
+            progress.report(1.0, true);
+            progress.throw_if_cancelled();
+            s->stage = gmpu_surface::Stage::fitted;
+            s->seconds[GMPU_STAGE_FIT] = since(t0);
+            return;
+        }
         const double noise = gmpu::estimate_noise(s->points, progress);
         const double epsilon = gmpu::effective_epsilon(s->points, s->params, noise);
         gmpu::Octree tree = gmpu::build_octree(s->points, s->params, epsilon, progress);
@@ -518,7 +573,17 @@ GMPU_API gmpu_status gmpu_surface_orient(gmpu_surface *s) {
         // Orient only writes the cells' signs and resets them first, so a cancelled or failed
         // orient leaves a fit that the next orient can use as it is.
         s->stage = gmpu_surface::Stage::fitted;
+        if (s->parts) {
+            push_params(s->params, *s->parts);
+            s->parts->orient(progress_or_stop, s);
+            progress.report(1.0, true);
+            progress.throw_if_cancelled();
+            s->stage = gmpu_surface::Stage::oriented;
+            s->seconds[GMPU_STAGE_ORIENT] = since(t0);
+            return;
+        }
         s->winding = gmpu::WindingField();
+        gmpu::check_orient_memory(s->tree, s->points, s->params.max_memory);
         gmpu::Octree &tree = s->tree;
         gmpu::OrientStats stats = gmpu::orient_octree(
             tree, s->points, s->input_normals.empty() ? nullptr : s->input_normals.data(), s->params, progress);
@@ -552,6 +617,7 @@ GMPU_API gmpu_status gmpu_surface_evaluate(const gmpu_surface *s, const double *
         for (size_t i = 0; i < 3 * count; ++i)
             if (!std::isfinite(xyz[i]))
                 throw Error(GMPU_ERROR_INVALID_INPUT, "query point " + std::to_string(i / 3) + " is NaN or infinite");
+        if (s->parts) return s->parts->evaluate(xyz, count, values, gradients);
         const gmpu::MpuFunction mpu(s->tree, s->params.level);
         const gmpu::SurfaceField f(mpu, s->points, s->measures, s->winding);
         const gmpu::Normalisation &norm = s->points.normalisation();
@@ -578,6 +644,7 @@ GMPU_API gmpu_status gmpu_surface_copy_normals(const gmpu_surface *s, double *ou
         if (count != s->input_count)
             throw Error(GMPU_ERROR_INVALID_ARGUMENT, "count " + std::to_string(count) + " differs from the " +
                                                          std::to_string(s->input_count) + " points");
+        if (s->parts) return s->parts->copy_normals(out, count);
         // An outlier takes the normal of the kept point nearest to it.
         size_t next_outlier = 0, kept = 0;
         for (size_t i = 0; i < count; ++i) {
@@ -600,6 +667,21 @@ GMPU_API gmpu_status gmpu_surface_polygonize(gmpu_surface *s, gmpu_mesh **out) {
         auto t0 = Clock::now();
         gmpu::Progress progress(s->progress_fn ? progress_or_stop : nullptr, s, GMPU_STAGE_POLYGONIZE);
         progress.report(0.0, true);
+        if (s->parts) {
+            push_params(s->params, *s->parts);
+            auto mesh = std::make_unique<gmpu_mesh>();
+            mesh->mesh = s->parts->polygonize(progress_or_stop, s);
+            if (double(mesh->mesh.triangle_count()) > s->params.max_triangles)
+                throw Error(GMPU_ERROR_LIMIT_EXCEEDED, "the clusters' meshes have " +
+                                                           std::to_string(mesh->mesh.triangle_count()) +
+                                                           " triangles together, over GMPU_PARAM_MAX_TRIANGLES");
+            progress.report(1.0, true);
+            progress.throw_if_cancelled();
+            s->last_resolution = int(s->parts->stat(GMPU_STAT_RESOLUTION));
+            s->seconds[GMPU_STAGE_POLYGONIZE] = since(t0);
+            *out = mesh.release();
+            return;
+        }
         int resolution = s->params.resolution > 0 ? s->params.resolution : gmpu::default_resolution(s->tree);
         const gmpu::MpuFunction mpu(s->tree, s->params.level);
         auto mesh = std::make_unique<gmpu_mesh>();

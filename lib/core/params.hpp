@@ -18,6 +18,7 @@ struct Params {
     double max_cells = 2e7;        // fit fails beyond this many cells
     double max_triangles = 1e8;    // polygonize fails beyond this many triangles
     double max_memory = default_memory_budget();  // bytes a stage may estimate to need
+    bool remove_outliers = true;   // set_points leaves the outliers out of the fit
 };
 
 }  // namespace gmpu

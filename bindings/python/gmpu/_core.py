@@ -35,7 +35,7 @@ _EVAL_CHUNK = 1 << 16  # query points per gmpu_surface_evaluate call
 
 _INT_PARAMS = {"max_depth", "min_points", "resolution", "level", "threads", "max_cells", "max_triangles",
                "max_memory"}
-_BOOL_PARAMS = {"sharp_features"}
+_BOOL_PARAMS = {"sharp_features", "remove_outliers"}
 _FLOAT_STATS = {"fit_seconds", "orient_seconds", "polygonize_seconds", "bbox_diagonal", "noise",
                 "effective_error"}
 
