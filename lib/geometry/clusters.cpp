@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <cstdint>
 #include <numeric>
-#include <unordered_map>
 
 namespace gmpu {
 
@@ -113,28 +113,34 @@ Clusters find_clusters(const T *xyz, size_t count, size_t stride, const std::vec
         return k;
     };
 
-    // Occupied cells, each joined with its occupied neighbours.
-    std::unordered_map<uint64_t, uint32_t> occupied;
+    // Occupied cells (a dense grid: at most 67³ entries), each joined with its occupied
+    // neighbours. The border of empty cells around the grid keeps neighbours in range.
+    constexpr uint32_t kEmpty = UINT32_MAX;
+    const uint64_t row = uint64_t(cells + 3);
+    std::vector<uint32_t> grid(row * row * row, kEmpty);
+    uint32_t occupied = 0;
     std::vector<uint32_t> cell_of(count, 0);
     is_outlier = Skip{outliers};
     for (size_t i = 0; i < count; ++i) {
         if (is_outlier(i)) continue;
         read_point<T>(bytes, stride, i, p);
-        cell_of[i] = occupied.emplace(key(p), uint32_t(occupied.size())).first->second;
+        uint32_t &cell = grid[key(p)];
+        if (cell == kEmpty) cell = occupied++;
+        cell_of[i] = cell;
     }
-    UnionFind pieces(occupied.size());
-    const uint64_t row = uint64_t(cells + 3);
-    for (const auto &[k, id] : occupied)
+    UnionFind pieces(occupied);
+    for (uint64_t k = 0; k < grid.size(); ++k) {
+        if (grid[k] == kEmpty) continue;
         for (int dx = -1; dx <= 1; ++dx)
             for (int dy = -1; dy <= 1; ++dy)
                 for (int dz = -1; dz <= 1; ++dz) {
                     const uint64_t n = k + uint64_t(int64_t(dx) * int64_t(row * row) + dy * int64_t(row) + dz);
-                    const auto it = occupied.find(n);
-                    if (it != occupied.end()) pieces.join(id, it->second);
+                    if (n < grid.size() && grid[n] != kEmpty) pieces.join(grid[k], grid[n]);
                 }
+    }
 
     // One box per piece, then groups merged until every two are apart and large enough.
-    std::vector<uint32_t> piece_of(occupied.size());
+    std::vector<uint32_t> piece_of(occupied);
     std::vector<Box> groups;
     for (uint32_t c = 0; c < piece_of.size(); ++c)
         if (pieces.find(c) == c) piece_of[c] = uint32_t(groups.size()), groups.emplace_back();
