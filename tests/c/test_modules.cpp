@@ -7,7 +7,10 @@
 #include <cmath>
 #include <map>
 #include <random>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <string>
 #include <stdexcept>
 #include <vector>
 
@@ -20,6 +23,7 @@
 #include "fit/fits.hpp"
 #include "fit/noise_estimate.hpp"
 #include "geometry/clusters.hpp"
+#include "io/io.hpp"
 #include "geometry/outliers.hpp"
 #include "geometry/point_set.hpp"
 #include "implicit/mpu_function.hpp"
@@ -270,6 +274,21 @@ void clusters_are_groups_far_apart(void **) {
     assert_int_equal(find_clusters(clump.data(), 3040, 0, none, 15).count, 1);
     // A cluster needs min_points too.
     assert_int_equal(find_clusters(both.data(), 3500, 0, none, 600).count, 1);
+    // Every cloud of tests/data is one object: one cluster, so its reconstruction takes the
+    // single-surface path, unchanged.
+    const char *root = std::getenv("GMPU_TEST_DATA");
+    assert_non_null(root);
+    size_t clouds = 0;
+    for (const auto &entry : std::filesystem::directory_iterator(std::string(root) + "/clouds")) {
+        const std::string path = entry.path().string();
+        if (entry.path().extension() != ".ply" || path.find("_gt.ply") != std::string::npos) continue;
+        const gmpu::io::PointCloud cloud = gmpu::io::read_points(path);
+        const OutlierScan scan = find_outliers(cloud.positions.data(), cloud.size(), 0);
+        if (find_clusters(cloud.positions.data(), cloud.size(), 0, scan.outliers, 15).count != 1)
+            fail_msg("%s: more than one cluster", path.c_str());
+        ++clouds;
+    }
+    assert_true(clouds >= 10);
 }
 
 void point_set_validation(void **) {
