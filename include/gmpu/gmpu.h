@@ -248,7 +248,8 @@ GMPU_API gmpu_status gmpu_surface_set_progress(gmpu_surface *surface, gmpu_progr
  * call treats them as one surface: one mesh (the clusters' meshes in the order of their
  * first points), normals in input order, evaluate answered by the cluster whose box is
  * nearest, statistics summed (depth and resolution: the largest; noise and effective
- * error: the cluster with most points).
+ * error: the cluster with most points). A failed or cancelled fit of such clusters keeps no
+ * fit (the clusters refit in turn).
  * Errors: INVALID_ARGUMENT (NULL, stride smaller than one point, count × stride beyond the
  * address space), INVALID_INPUT (fewer
  * points than GMPU_PARAM_MIN_POINTS; a NaN or infinite coordinate, with its index; a

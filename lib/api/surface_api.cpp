@@ -542,6 +542,9 @@ GMPU_API gmpu_status gmpu_surface_fit(gmpu_surface *s) {
         gmpu::Progress progress(s->progress_fn ? progress_or_stop : nullptr, s, GMPU_STAGE_FIT);
         progress.report(0.0, true);
         if (s->parts) {
+            // Each cluster's fit replaces its own as it goes: until all are done, the
+            // clusters do not share one fit, so a failed or cancelled fit leaves none.
+            s->discard_fit();
             push_params(s->params, *s->parts);
             s->parts->fit(progress_or_stop, s);
             progress.report(1.0, true);

@@ -831,6 +831,21 @@ static size_t sphere_vertices(const gmpu_mesh *m, const double c[3], double radi
     return n;
 }
 
+/* Progress of a clustered surface: one stage from 0 to 1 across its clusters; a cancel in
+ * the second cluster's share stops the whole stage. */
+typedef struct {
+    double last, cancel_at;
+    int decreasing, calls;
+} cluster_watch;
+static int on_cluster_progress(void *user, gmpu_stage stage, double fraction) {
+    cluster_watch *w = user;
+    (void)stage;
+    w->decreasing |= fraction < w->last;
+    w->last = fraction;
+    ++w->calls;
+    return w->cancel_at > 0 && fraction >= w->cancel_at;
+}
+
 /* Clusters far apart (a unit sphere and one of radius 1000 a million units away): each is
  * reconstructed at its own scale, exactly as if alone (the merged mesh is the two meshes one
  * after the other), normals come back in input order, and evaluate answers with the nearest
@@ -881,6 +896,17 @@ static void test_separate_clusters(void **state) {
     assert_ok(gmpu_surface_set_normals_f64(s, normals, 2 * N_GOOD, 0));
     check_failure(gmpu_surface_evaluate(s, q, 1, f, NULL), GMPU_ERROR_WRONG_ORDER, "orient");
     assert_ok(gmpu_surface_orient(s));
+    /* One fit from 0 to 1 over both clusters; cancelled in the second, it is cancelled. */
+    cluster_watch w = {0, 0, 0, 0};
+    assert_ok(gmpu_surface_set_progress(s, on_cluster_progress, &w));
+    assert_ok(gmpu_surface_fit(s));
+    assert_true(!w.decreasing && w.last == 1.0 && w.calls >= 3);
+    cluster_watch stop = {0, 0.75, 0, 0};
+    assert_ok(gmpu_surface_set_progress(s, on_cluster_progress, &stop));
+    check_failure(gmpu_surface_fit(s), GMPU_ERROR_CANCELLED, "cluster 2 of 2");
+    assert_ok(gmpu_surface_set_progress(s, NULL, NULL));
+    /* The clusters no longer share one fit: none is kept (one surface keeps its old one). */
+    check_failure(gmpu_surface_orient(s), GMPU_ERROR_WRONG_ORDER, "gmpu_surface_fit");
     gmpu_mesh_destroy(m);
     gmpu_mesh_destroy(small_mesh);
     gmpu_mesh_destroy(big_mesh);
