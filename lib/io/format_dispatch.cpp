@@ -102,16 +102,17 @@ std::string read_ply_bytes(InputFile &file, const std::string &path, double budg
     return bytes;
 }
 
-// Progress: the bytes read, then parsed, each pass a share of the whole.
-Parsed parse(Format f, InputFile &file, const std::string &path, Want want, const ReadOptions &options) {
+// Progress: the bytes read, then parsed, each pass a share of the whole (the values' check
+// after it takes the last tenth).
+Parsed parse(Format f, InputFile &file, const std::string &path, Want want, const ReadOptions &options,
+             ReadTicker &ticker) {
     const double budget = options.max_memory > 0.0 ? options.max_memory : default_memory_budget();
-    ReadTicker ticker{options.progress};
     file.set_ticker(&ticker);
     if (f == Format::ply) {
-        ticker.pass(0.0, 0.5);
+        ticker.pass(0.0, 0.45);
         const std::string bytes = read_ply_bytes(file, path, budget);
         file.set_ticker(nullptr);
-        ticker.pass(0.5, 0.5);
+        ticker.pass(0.45, 0.45);
         return parse_ply_buffer(bytes.data(), bytes.size(), path, want, &ticker);
     }
     // Text formats: read in chunks, the arrays sized once from a count of the lines, so a
@@ -120,7 +121,7 @@ Parsed parse(Format f, InputFile &file, const std::string &path, Want want, cons
     ticker.pass(0.0, 0.2);
     const uint64_t line_count = count_lines(file, path);
     check_read_memory(path, line_count, double(kLineBufferBytes), budget);
-    ticker.pass(0.2, 0.8);
+    ticker.pass(0.2, 0.7);
     LineReader lines(file, path);
     switch (f) {
         case Format::xyz: return parse_xyz_lines(lines, path, line_count);
@@ -131,24 +132,28 @@ Parsed parse(Format f, InputFile &file, const std::string &path, Want want, cons
     fail(GMPU_ERROR_INTERNAL, path, "unknown format");
 }
 
-void check_finite(const std::vector<double> &v, const std::string &name, const char *what) {
-    for (size_t i = 0; i < v.size(); ++i)
+void check_finite(const std::vector<double> &v, const std::string &name, const char *what,
+                  const ReadTicker *ticker) {
+    constexpr size_t kTickValues = size_t{1} << 16;
+    for (size_t i = 0; i < v.size(); ++i) {
+        if (ticker && i % kTickValues == 0) ticker->at(double(i) / double(v.size()));
         if (!std::isfinite(v[i]))
             fail(GMPU_ERROR_INVALID_INPUT, name, "vertex " + std::to_string(i / 3) + " has a non-finite " + what +
                                                      " (" + std::to_string(v[i]) + ")");
+    }
 }
 
 }  // namespace
 
-void check_points(const Parsed &parsed, const std::string &name) {
+void check_points(const Parsed &parsed, const std::string &name, const ReadTicker *ticker) {
     if (parsed.positions.empty()) fail(GMPU_ERROR_INVALID_INPUT, name, "no points");
-    check_finite(parsed.positions, name, "coordinate");
-    check_finite(parsed.normals, name, "normal");
+    check_finite(parsed.positions, name, "coordinate", ticker);
+    check_finite(parsed.normals, name, "normal", ticker);
 }
 
 void check_mesh(const Parsed &parsed, const std::string &name) {
     if (parsed.positions.empty()) fail(GMPU_ERROR_INVALID_INPUT, name, "no vertices");
-    check_finite(parsed.positions, name, "coordinate");
+    check_finite(parsed.positions, name, "coordinate", nullptr);
 }
 
 }  // namespace detail
@@ -158,8 +163,10 @@ using detail::fail;
 PointCloud read_points(const std::string &path, const ReadOptions &options) {
     const detail::Format f = detail::format_of(path, detail::reading_points);
     detail::InputFile file(path);
-    detail::Parsed parsed = detail::parse(f, file, path, detail::Want::points, options);
-    detail::check_points(parsed, path);
+    detail::ReadTicker ticker{options.progress};
+    detail::Parsed parsed = detail::parse(f, file, path, detail::Want::points, options, ticker);
+    ticker.pass(0.9, 0.1);
+    detail::check_points(parsed, path, &ticker);
     PointCloud cloud;
     cloud.positions = std::move(parsed.positions);
     cloud.normals = std::move(parsed.normals);
@@ -169,7 +176,8 @@ PointCloud read_points(const std::string &path, const ReadOptions &options) {
 MeshData read_mesh(const std::string &path) {
     const detail::Format f = detail::format_of(path, detail::reading_meshes);
     detail::InputFile file(path);
-    detail::Parsed parsed = detail::parse(f, file, path, detail::Want::mesh, ReadOptions{});
+    detail::ReadTicker ticker;
+    detail::Parsed parsed = detail::parse(f, file, path, detail::Want::mesh, ReadOptions{}, ticker);
     detail::check_mesh(parsed, path);
     MeshData mesh;
     mesh.vertices = std::move(parsed.positions);

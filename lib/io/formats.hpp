@@ -50,7 +50,7 @@ bool check_ply_header(const char *data, size_t size, const std::string &name, ui
 
 // INVALID_INPUT for a non-finite coordinate or normal (naming the vertex index) and for
 // an empty result ("no points" / "no vertices").
-void check_points(const Parsed &parsed, const std::string &name);
+void check_points(const Parsed &parsed, const std::string &name, const ReadTicker *ticker = nullptr);
 void check_mesh(const Parsed &parsed, const std::string &name);
 
 // Writers append the whole file to `out`; the caller commits it. `mesh.triangles` is

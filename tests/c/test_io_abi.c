@@ -185,7 +185,7 @@ static void test_points_read_budget(void **state) {
     assert_non_null(strstr(gmpu_last_error(), ply));
     /* Refused from the header: far less CPU than reading 64 MB and converting 5.6M points. */
     const double cpu = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
-    if (cpu > 0.05) fail_msg("the refused read took %.3f s of CPU", cpu);
+    if (cpu > 0.05 && getenv("GMPU_TEST_QUICK") == NULL) fail_msg("the refused read took %.3f s of CPU", cpu);
     remove(ply);
 
     const char *xyz = scratch_path("many.xyz");
@@ -250,7 +250,7 @@ static void test_points_read_progress_and_cancel(void **state) {
 #else
     const int timing = getenv("GMPU_TEST_QUICK") == NULL;
 #endif
-    const size_t n = 1000000;
+    const size_t n = getenv("GMPU_TEST_QUICK") ? 20000 : 1000000; /* valgrind: small, no timing */
     const char *xyz = scratch_path("large.xyz"), *ply = scratch_path("large.ply");
     FILE *f = fopen(xyz, "wb");
     assert_non_null(f);
@@ -274,7 +274,7 @@ static void test_points_read_progress_and_cancel(void **state) {
         assert_int_equal(gmpu_points_count(p), k ? 4 * n : n);
         gmpu_points_destroy(p);
         assert_false(w.wrong_stage || w.decreasing);
-        assert_true(w.last_fraction == 1.0 && w.reports >= 3);
+        assert_true(w.last_fraction == 1.0 && (w.reports >= 3 || !timing));
         if (timing && w.max_gap > 0.05) fail_msg("%s: %.3f s of CPU between two reports", files[k], w.max_gap);
         const double cancel_at[] = {0.1, 0.6};
         for (int c = 0; c < 2; ++c) {
