@@ -165,22 +165,14 @@ Clusters find_clusters(const T *xyz, size_t count, size_t stride, const std::vec
             for (size_t b = a + 1; alive[a] && b < groups.size(); ++b)
                 if (alive[b] && groups[a].gap(groups[b]) <= kClusterGap * std::max(groups[a].side(), groups[b].side()))
                     merge(a, b), changed = true;
-        // The smallest group that cannot stand alone (too few points, or flat: no solid)
-        // joins the one nearest to it.
-        auto alone = [&](const Box &g) { return g.points >= need && g.thinnest() > kFlat * g.side(); };
-        size_t small = groups.size();
-        for (size_t a = 0; a < groups.size(); ++a)
-            if (alive[a] && !alone(groups[a]) && (small == groups.size() || groups[a].points < groups[small].points))
-                small = a;
-        if (small == groups.size()) continue;
-        size_t nearest = groups.size();
-        for (size_t a = 0; a < groups.size(); ++a)
-            if (alive[a] && a != small && (nearest == groups.size() || groups[small].gap(groups[a]) < groups[small].gap(groups[nearest])))
-                nearest = a;
-        if (nearest == groups.size()) break;  // one group left
-        merge(std::min(small, nearest), std::max(small, nearest));
-        changed = true;
     }
+    // Every two groups are apart now. One that cannot stand alone (too few points, or flat:
+    // no solid) is a stray, like an outlier: its points go to the nearest cluster (whose own
+    // outlier scan sees them) but do not widen its box, which would join it to its neighbour.
+    std::vector<bool> stray(groups.size(), false);
+    for (size_t a = 0; a < groups.size(); ++a)
+        if (alive[a] && !(groups[a].points >= need && groups[a].thinnest() > kFlat * groups[a].side()))
+            alive[a] = false, stray[a] = true;
     std::vector<uint32_t> label_of(groups.size(), 0);
     for (size_t a = 0; a < groups.size(); ++a)
         if (alive[a]) {
@@ -196,11 +188,11 @@ Clusters find_clusters(const T *xyz, size_t count, size_t stride, const std::vec
     result.labels.resize(count);
     is_outlier = Skip{outliers};
     for (size_t i = 0; i < count; ++i) {
-        if (!is_outlier(i)) {
+        if (!is_outlier(i) && !stray[merged.find(piece_of[cell_of[i]])]) {
             result.labels[i] = label_of[merged.find(piece_of[cell_of[i]])];
             continue;
         }
-        read_point<T>(bytes, stride, i, p);  // an outlier: the nearest cluster
+        read_point<T>(bytes, stride, i, p);  // an outlier or a stray: the nearest cluster
         double best = INFINITY;
         for (size_t a = 0, c = 0; a < groups.size(); ++a)
             if (alive[a]) {

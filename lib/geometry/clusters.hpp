@@ -19,7 +19,8 @@ struct Clusters {
 };
 
 // A cluster needs this many points (and at least min_points) and a box that is not flat to
-// stand on its own; a smaller or flat group joins the nearest cluster.
+// stand on its own; a smaller or flat group is a stray: its points go to the nearest cluster,
+// like outliers, without widening its box.
 constexpr size_t kMinClusterPoints = 64;
 // Two groups stay apart when the gap between their boxes exceeds this times the larger box's
 // longest side; nearer groups (one object sampled with holes, nested shells) are one cluster.

@@ -262,6 +262,14 @@ void clusters_are_groups_far_apart(void **) {
     Clusters three = find_clusters(stray.data(), 3501, 0, std::vector<uint32_t>{3500}, 15);
     assert_int_equal(three.count, 2);
     assert_int_equal(three.labels[3500], 1);
+    // A stray the outlier scan left (the box is not wider than the bulk: half the points are at
+    // each end) does not join the clusters: it goes to the nearer, whose box it does not widen.
+    Clusters strayed = find_clusters(stray.data(), 3501, 0, none, 15);
+    assert_int_equal(strayed.count, 2);
+    assert_int_equal(strayed.labels[3500], 1);
+    assert_true(strayed.boxes[1][3] < 1e6 + 2);
+    stray[3 * 3500] = 5e5;  // halfway: still no bridge
+    assert_int_equal(find_clusters(stray.data(), 3501, 0, none, 15).count, 2);
     // Nearer than their size, nested, or too few points to stand alone: one cluster.
     std::vector<double> near = shifted(sphere_points(500, 1000, 0, 2), Vector3d(2900, 0, 0));
     near.insert(near.begin(), big.begin(), big.end());
