@@ -146,8 +146,8 @@ typedef enum gmpu_param {
      * max(GMPU_PARAM_ERROR, NOISE_SCALE × σ̂), since fitting below the noise only fits the
      * noise; 0 turns the floor off. Discards a previous fit. Default 1.75, range [0, 20]. */
     GMPU_PARAM_NOISE_SCALE = 11,
-    /* Memory budget in bytes: fit and polygonize first estimate their peak memory (from the
-     * point count, the cell cap and the grid resolution) and fail with
+    /* Memory budget in bytes: fit, orient and polygonize first estimate their peak memory
+     * (from the point count, the cell cap, the fit's cells and the grid resolution) and fail with
      * GMPU_ERROR_LIMIT_EXCEEDED, naming the estimate and the budget, instead of starting
      * work the machine cannot hold. Default half the physical memory, range 1e6..1e15. */
     GMPU_PARAM_MAX_MEMORY = 12,
@@ -291,7 +291,8 @@ GMPU_API gmpu_status gmpu_surface_fit(gmpu_surface *surface);
  * connected piece; then each piece is turned so that f is positive inside the solid
  * (nested shells alternate: a shell inside a shell bounds a cavity). With input normals,
  * their agreement signs the fits instead. Also computes the per-point oriented normals.
- * Errors: WRONG_ORDER (not fitted), CANCELLED, OUT_OF_MEMORY. */
+ * Errors: WRONG_ORDER (not fitted), LIMIT_EXCEEDED (GMPU_PARAM_MAX_MEMORY, checked before it
+ * starts; the fit is kept), CANCELLED, OUT_OF_MEMORY. */
 GMPU_API gmpu_status gmpu_surface_orient(gmpu_surface *surface);
 
 /* Evaluates the blended implicit f (partition of unity, quadratic B-spline weights) at
