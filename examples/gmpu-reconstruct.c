@@ -32,7 +32,7 @@
 typedef struct {
     const char *input, *output, *normals_out;
     double error, max_depth, resolution, level, threads, noise_scale, max_memory;
-    int use_normals, sharp, quiet;
+    int use_normals, sharp, quiet, keep_outliers;
     int param_count; /* --param NAME=VALUE, applied after the flags above, in order */
     gmpu_param param_keys[MAX_PARAMS];
     double param_values[MAX_PARAMS];
@@ -44,9 +44,11 @@ static const char *usage =
     "usage: gmpu-reconstruct INPUT -o OUTPUT [--normals-out POINTS.ply] [--error E]\n"
     "                        [--max-depth D] [--resolution R] [--level L] [--threads T]\n"
     "                        [--noise-scale S] [--max-memory BYTES] [--param NAME=VALUE]...\n"
-    "                        [--use-normals] [--sharp] [--quiet] [--version]\n"
+    "                        [--use-normals] [--sharp] [--keep-outliers] [--quiet] [--version]\n"
     "  INPUT   .ply .xyz .txt .off .obj point cloud (normals ignored unless --use-normals)\n"
     "  OUTPUT  .ply .obj .off mesh (closed, outward-facing)\n"
+    "  --keep-outliers fits the outliers found (points far from all others) too; by default\n"
+    "  they are reported and set aside.\n"
     "  Options take their value as the next argument or after '=' (--resolution=64).\n"
     "  A file name starting with '-' must be written ./-name.\n"
     "  --param NAME=VALUE sets any parameter (--help lists them).\n";
@@ -112,7 +114,7 @@ static int parse_path(const char *flag, const char *text, const char **out) {
 }
 
 enum { OPT_NORMALS_OUT = 256, OPT_ERROR, OPT_MAX_DEPTH, OPT_RESOLUTION, OPT_LEVEL, OPT_THREADS, OPT_USE_NORMALS,
-       OPT_SHARP, OPT_NOISE_SCALE, OPT_MAX_MEMORY, OPT_PARAM };
+       OPT_SHARP, OPT_NOISE_SCALE, OPT_MAX_MEMORY, OPT_PARAM, OPT_KEEP_OUTLIERS };
 
 static const struct option long_options[] = {
     {"output", required_argument, NULL, 'o'},
@@ -127,6 +129,7 @@ static const struct option long_options[] = {
     {"param", required_argument, NULL, OPT_PARAM},
     {"use-normals", no_argument, NULL, OPT_USE_NORMALS},
     {"sharp", no_argument, NULL, OPT_SHARP},
+    {"keep-outliers", no_argument, NULL, OPT_KEEP_OUTLIERS},
     {"quiet", no_argument, NULL, 'q'},
     {"help", no_argument, NULL, 'h'},
     {"version", no_argument, NULL, 'V'},
@@ -184,6 +187,7 @@ static int parse_args(int argc, char **argv, options *o) {
             case OPT_PARAM: if (!parse_param(optarg, o)) return 0; break;
             case OPT_USE_NORMALS: o->use_normals = 1; break;
             case OPT_SHARP: o->sharp = 1; break;
+            case OPT_KEEP_OUTLIERS: o->keep_outliers = 1; break;
             case 'q': o->quiet = 1; break;
             case ':': {
                 const char *what = argv[optind - 1];
@@ -222,6 +226,7 @@ static const char *stage_name(gmpu_stage s) {
         case GMPU_STAGE_FIT: return "fit";
         case GMPU_STAGE_ORIENT: return "orient";
         case GMPU_STAGE_POLYGONIZE: return "polygonize";
+        case GMPU_STAGE_READ: return "read";
     }
     return "work";
 }
@@ -258,6 +263,18 @@ static int fail(const char *what) {
     return 1;
 }
 
+/* A failed write of a staging file, told about the user's file: the library's message names
+ * the staging path (and its temporaries, which start with it), which the user never gave. */
+static int fail_staged(const char *what, const staged_output *out) {
+    const char *msg = gmpu_last_error(), *at = out->staging[0] ? strstr(msg, out->staging) : NULL;
+    if (!at) return fail(what);
+    const char *rest = at + strlen(out->staging);
+    if (*rest == '.') /* a temporary beside the staging file: ".tmp-gmpu-PID-N" */
+        while (*rest && *rest != ':' && *rest != ' ') ++rest;
+    fprintf(stderr, "gmpu-reconstruct: %s: %.*s%s%s\n", what, (int)(at - msg), msg, out->given, rest);
+    return 1;
+}
+
 static int set(gmpu_surface *s, gmpu_param key, double value) {
     return isnan(value) || gmpu_surface_set_param(s, key, value) == GMPU_OK;
 }
@@ -270,8 +287,9 @@ static int write_outputs(gmpu_mesh **mesh, gmpu_surface **surface, const gmpu_po
     const size_t n = gmpu_points_count(cloud);
     if (!output_stage(mesh_out, msg, sizeof msg)) goto failed;
     if (gmpu_mesh_write(*mesh, mesh_out->staging) != GMPU_OK) {
+        const int status = fail_staged("cannot write mesh", mesh_out);
         output_discard(mesh_out);
-        return fail("cannot write mesh");
+        return status;
     }
     /* Written: free it before the oriented points need their memory (peak matters at 1M). */
     gmpu_mesh_destroy(*mesh);
@@ -287,12 +305,14 @@ static int write_outputs(gmpu_mesh **mesh, gmpu_surface **surface, const gmpu_po
         *surface = NULL;
         ok = ok && gmpu_points_create(gmpu_points_positions(cloud), normals, n, &oriented) == GMPU_OK;
         free(normals);
-        ok = ok && gmpu_points_write(oriented, points_out->staging) == GMPU_OK;
+        const int written = ok && gmpu_points_write(oriented, points_out->staging) == GMPU_OK;
         gmpu_points_destroy(oriented);
-        if (!ok) {
+        if (!written) {
+            const int status = ok ? fail_staged("cannot write oriented points", points_out)
+                                  : fail("cannot write oriented points");
             output_discard(points_out);
             output_discard(mesh_out);
-            return fail("cannot write oriented points");
+            return status;
         }
     }
     if (!output_commit(mesh_out, msg, sizeof msg)) goto failed;
@@ -338,7 +358,14 @@ int main(int argc, char **argv) {
     double stat[10] = {0};
     int stat_count = 0, rc = 1;
 
-    if (gmpu_points_read(o.input, &cloud) != GMPU_OK) { rc = fail("cannot read input"); goto done; }
+    /* The budget bounds the read too: a file whose points would not fit fails before its
+     * body is read. Reading shows a bar on a terminal (elsewhere its line would precede a
+     * read error's, which is one line). */
+    if (gmpu_points_read_with(o.input, isnan(o.max_memory) ? 0.0 : o.max_memory, prog.tty ? on_progress : NULL, &prog,
+                              &cloud) != GMPU_OK) {
+        rc = fail("cannot read input");
+        goto done;
+    }
     double t_read = now_seconds();
     size_t n = gmpu_points_count(cloud);
     if (gmpu_surface_create(&surface) != GMPU_OK) { rc = fail("cannot create surface"); goto done; }
@@ -346,7 +373,8 @@ int main(int argc, char **argv) {
         !set(surface, GMPU_PARAM_RESOLUTION, o.resolution) || !set(surface, GMPU_PARAM_LEVEL, o.level) ||
         !set(surface, GMPU_PARAM_THREADS, o.threads) || !set(surface, GMPU_PARAM_NOISE_SCALE, o.noise_scale) ||
         !set(surface, GMPU_PARAM_MAX_MEMORY, o.max_memory) ||
-        !set(surface, GMPU_PARAM_SHARP_FEATURES, o.sharp ? 1.0 : NAN)) {
+        !set(surface, GMPU_PARAM_SHARP_FEATURES, o.sharp ? 1.0 : NAN) ||
+        !set(surface, GMPU_PARAM_REMOVE_OUTLIERS, o.keep_outliers ? 0.0 : NAN)) {
         rc = fail("bad parameter");
         goto done;
     }
@@ -362,7 +390,8 @@ int main(int argc, char **argv) {
     }
     double outliers = 0;
     if (!o.quiet && gmpu_surface_get_stat(surface, GMPU_STAT_OUTLIERS, &outliers) == GMPU_OK && outliers > 0)
-        fprintf(stderr, "gmpu: %.0f outlier points (far from all others) set aside\n", outliers);
+        fprintf(stderr, "gmpu: %.0f outlier points (far from all others) %s\n", outliers,
+                o.keep_outliers ? "kept (--keep-outliers)" : "set aside");
     if (o.use_normals) {
         if (!gmpu_points_normals(cloud)) {
             fprintf(stderr, "gmpu-reconstruct: --use-normals given but %s has no normals\n", o.input);

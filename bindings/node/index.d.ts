@@ -90,6 +90,8 @@ export interface Parameters {
     noiseScale?: number;
     /** Memory budget in bytes that fit and polygonize check their estimated peak against. */
     maxMemory?: number;
+    /** 1: set_points leaves the outliers it finds out of the fit; 0: fits them too (GMPU_STAT_OUTLIERS counts them either way). Default 1, 0..1. */
+    removeOutliers?: boolean | number;
 }
 export type ParameterName = keyof Parameters;
 export declare const parameterNames: readonly ParameterName[];

@@ -147,11 +147,17 @@ typedef enum gmpu_param {
      * max(GMPU_PARAM_ERROR, NOISE_SCALE × σ̂), since fitting below the noise only fits the
      * noise; 0 turns the floor off. Discards a previous fit. Default 1.75, range [0, 20]. */
     GMPU_PARAM_NOISE_SCALE = 11,
-    /* Memory budget in bytes: fit and polygonize first estimate their peak memory (from the
-     * point count, the cell cap and the grid resolution) and fail with
+    /* Memory budget in bytes: fit, orient and polygonize first estimate their peak memory
+     * (from the point count, the cell cap, the fit's cells and the grid resolution) and fail with
      * GMPU_ERROR_LIMIT_EXCEEDED, naming the estimate and the budget, instead of starting
      * work the machine cannot hold. Default half the physical memory, range 1e6..1e15. */
-    GMPU_PARAM_MAX_MEMORY = 12
+    GMPU_PARAM_MAX_MEMORY = 12,
+    /* 1: set_points leaves out of the fit the outliers it finds (points far from every other
+     * compared with the cloud's spacing), so that they set neither the scale nor a blob; each
+     * takes the normal of the kept point nearest to it. 0: they are fitted like the others.
+     * Either way GMPU_STAT_OUTLIERS counts them. Read by set_points: set it before.
+     * Default 1, range 0..1. */
+    GMPU_PARAM_REMOVE_OUTLIERS = 13
 } gmpu_param;
 
 /* The parameter table: what every gmpu_param key is, for bindings and tools that list,
@@ -187,7 +193,8 @@ GMPU_API int gmpu_param_key(const char *name);
 typedef enum gmpu_stage {
     GMPU_STAGE_FIT = 1,
     GMPU_STAGE_ORIENT = 2,
-    GMPU_STAGE_POLYGONIZE = 3
+    GMPU_STAGE_POLYGONIZE = 3,
+    GMPU_STAGE_READ = 4 /* gmpu_points_read_with */
 } gmpu_stage;
 
 typedef enum gmpu_stat {
@@ -209,9 +216,10 @@ typedef enum gmpu_stat {
     GMPU_STAT_BBOX_DIAGONAL = 14,     /* diagonal of the points' bounding box (outliers aside) */
     GMPU_STAT_NOISE = 15,             /* estimated noise σ̂, as a fraction of the diagonal */
     GMPU_STAT_EFFECTIVE_ERROR = 16,   /* the ε fit worked to, as a fraction of the diagonal */
-    GMPU_STAT_OUTLIERS = 17           /* input points set aside as outliers by set_points: far
+    GMPU_STAT_OUTLIERS = 17           /* input points set_points found to be outliers: far
                                        * from every other point compared with the cloud's
-                                       * spacing; they set no scale and join no fit */
+                                       * spacing; unless GMPU_PARAM_REMOVE_OUTLIERS is 0 they
+                                       * set no scale and join no fit */
 } gmpu_stat;
 
 /* Progress and cancellation. Called on the thread that called fit / orient / polygonize,
@@ -262,15 +270,22 @@ GMPU_API gmpu_status gmpu_surface_set_progress(gmpu_surface *surface, gmpu_progr
  * (0 means tightly packed: 3 × sizeof(double) or 3 × sizeof(float)). Replaces earlier
  * points and discards any fit, orientation and input normals. Outliers — points whose 4th
  * nearest neighbour is over 20 times farther than is typical for the cloud — are set aside
- * (GMPU_STAT_OUTLIERS): they neither set the scale (the bounding box, ε, the grid are the
- * other points') nor join a fit; they still count as points for set_normals and
- * copy_normals.
+ * (GMPU_STAT_OUTLIERS) unless GMPU_PARAM_REMOVE_OUTLIERS is 0: they neither set the scale
+ * (the bounding box, ε, the grid are the other points') nor join a fit; they still count as
+ * points for set_normals and copy_normals. Spatially separated clusters — groups of points
+ * whose bounding boxes are farther apart than the larger one's longest side, each of at
+ * least 64 points and GMPU_PARAM_MIN_POINTS — are each reconstructed at their own scale
+ * (their own outliers, octree, ε, orientation and grid, as if each were alone); every later
+ * call treats them as one surface: one mesh (the clusters' meshes in the order of their
+ * first points), normals in input order, evaluate answered by the cluster whose box is
+ * nearest, statistics summed (depth and resolution: the largest; noise and effective
+ * error: the cluster with most points). A failed or cancelled fit of such clusters keeps no
+ * fit (the clusters refit in turn).
  * Errors: INVALID_ARGUMENT (NULL, stride smaller than one point, count × stride beyond the
  * address space), INVALID_INPUT (fewer
  * points than GMPU_PARAM_MIN_POINTS; a NaN or infinite coordinate, with its index; a
  * coordinate beyond ±1e300 or a cloud spanning less than 1e-300: they cannot be normalised;
- * clusters so far apart that the points' spacing is below a millionth of their extent:
- * reconstruct each on its own surface), DEGENERATE_INPUT (all points identical, collinear or coplanar: they bound no volume),
+ * points spaced below a millionth of their extent that do not form separate clusters), DEGENERATE_INPUT (all points identical, collinear or coplanar: they bound no volume),
  * OUT_OF_MEMORY. On failure the previous points are kept. Cost: O(n log n). */
 GMPU_API gmpu_status gmpu_surface_set_points_f64(gmpu_surface *surface, const double *xyz,
                                                  size_t count, size_t stride);
@@ -307,7 +322,8 @@ GMPU_API gmpu_status gmpu_surface_fit(gmpu_surface *surface);
  * connected piece; then each piece is turned so that f is positive inside the solid
  * (nested shells alternate: a shell inside a shell bounds a cavity). With input normals,
  * their agreement signs the fits instead. Also computes the per-point oriented normals.
- * Errors: WRONG_ORDER (not fitted), CANCELLED, OUT_OF_MEMORY. */
+ * Errors: WRONG_ORDER (not fitted), LIMIT_EXCEEDED (GMPU_PARAM_MAX_MEMORY, checked before it
+ * starts; the fit is kept), CANCELLED, OUT_OF_MEMORY. */
 GMPU_API gmpu_status gmpu_surface_orient(gmpu_surface *surface);
 
 /* Evaluates the blended implicit f (partition of unity, quadratic B-spline weights) at
@@ -374,8 +390,20 @@ GMPU_API gmpu_status gmpu_mesh_write(const gmpu_mesh *mesh, const char *path);
  * directory fails at once. Errors: INVALID_ARGUMENT, IO (missing, unreadable, not a regular
  * file), PARSE (malformed, truncated or lying header, not the format its extension says;
  * the message gives the line or element), UNSUPPORTED (extension or PLY variant),
- * INVALID_INPUT (no points). */
+ * INVALID_INPUT (no points), LIMIT_EXCEEDED (the points would need more memory than half the
+ * physical memory: see gmpu_points_read_with). */
 GMPU_API gmpu_status gmpu_points_read(const char *path, gmpu_points **out);
+
+/* gmpu_points_read with a memory budget and progress. max_memory: bytes (0: the default,
+ * half the physical memory; else 1e6..1e15, as GMPU_PARAM_MAX_MEMORY): a file whose points
+ * would need more — estimated from a PLY header's vertex count and the file's size, or a
+ * text file's line count, 48 bytes a point — fails with LIMIT_EXCEEDED naming the estimate
+ * and the budget, before its body is read or parsed. fn (may be NULL) gets stage
+ * GMPU_STAGE_READ and the fraction of the file read and parsed, with the cadence and the
+ * cancel promise of gmpu_progress_fn (every 50 ms of the calling thread's CPU, stops within
+ * 100 ms; then CANCELLED and *out stays NULL). */
+GMPU_API gmpu_status gmpu_points_read_with(const char *path, double max_memory, gmpu_progress_fn fn,
+                                           void *user, gmpu_points **out);
 
 /* Builds a point set from caller arrays (copied); normals may be NULL. */
 GMPU_API gmpu_status gmpu_points_create(const double *xyz, const double *normals,

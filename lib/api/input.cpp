@@ -94,15 +94,19 @@ void check_array(const void *data, size_t count, size_t stride, size_t element, 
 }
 
 template <class T>
-InputPoints input_points(const T *xyz, size_t count, size_t stride, size_t min_points) {
-    gmpu::OutlierScan scan = gmpu::find_outliers(xyz, count, stride);
+InputPoints input_points(const T *xyz, size_t count, size_t stride, size_t min_points, OutlierScan scan,
+                         bool remove_outliers) {
     // The points' own spacing, not their bounding box, is the scale of the detail: one
     // octree in float coordinates resolves about a millionth of the extent.
     if (scan.spacing > 0.0 && scan.spacing < 1e-6 * scan.extent) throw clusters(scan);
     InputPoints in;
-    in.points = scan.outliers.empty() ? points_or_clusters(xyz, count, stride, min_points)
-                                      : kept_points(xyz, count, stride, min_points, scan.outliers, in.nearest);
-    in.outliers = std::move(scan.outliers);
+    if (remove_outliers && !scan.outliers.empty()) {
+        in.points = kept_points(xyz, count, stride, min_points, scan.outliers, in.nearest);
+        in.outliers = std::move(scan.outliers);
+    } else {  // kept in the fit, but still reported
+        in.points = points_or_clusters(xyz, count, stride, min_points);
+        in.points.set_outlier_count(scan.outliers.size());
+    }
     return in;
 }
 
@@ -134,8 +138,8 @@ std::vector<float> unit_normals(const T *nxyz, size_t count, size_t stride, cons
     return unit;
 }
 
-template InputPoints input_points(const float *, size_t, size_t, size_t);
-template InputPoints input_points(const double *, size_t, size_t, size_t);
+template InputPoints input_points(const float *, size_t, size_t, size_t, OutlierScan, bool);
+template InputPoints input_points(const double *, size_t, size_t, size_t, OutlierScan, bool);
 template std::vector<float> unit_normals(const float *, size_t, size_t, const std::vector<uint32_t> &);
 template std::vector<float> unit_normals(const double *, size_t, size_t, const std::vector<uint32_t> &);
 

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "geometry/outliers.hpp"
 #include "geometry/point_set.hpp"
 
 namespace gmpu::api {
@@ -20,10 +21,12 @@ struct InputPoints {
     std::vector<uint32_t> nearest;   // per outlier: the kept point nearest to it
 };
 
-// count points, x y z each, stride bytes apart (0: packed). Throws INVALID_INPUT or
-// DEGENERATE_INPUT (see gmpu_surface_set_points).
+// count points, x y z each, stride bytes apart (0: packed), whose outlier scan is given.
+// remove_outliers false keeps the outliers in the points (still counted). Throws
+// INVALID_INPUT or DEGENERATE_INPUT (see gmpu_surface_set_points).
 template <class T>
-InputPoints input_points(const T *xyz, size_t count, size_t stride, size_t min_points);
+InputPoints input_points(const T *xyz, size_t count, size_t stride, size_t min_points, OutlierScan scan,
+                         bool remove_outliers);
 
 // The unit normals of the points that are not outliers (3 floats each), from count normals
 // stride bytes apart (0: packed). Throws INVALID_INPUT naming a NaN, infinite or zero normal.

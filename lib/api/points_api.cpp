@@ -6,6 +6,7 @@
 
 #include "api/guard.hpp"
 #include "api/handles.hpp"
+#include "core/progress.hpp"
 #include "gmpu/gmpu.h"
 #include "io/io.hpp"
 
@@ -26,15 +27,30 @@ void copy_finite(std::vector<double> &dst, const double *src, size_t count, cons
 
 extern "C" {
 
-GMPU_API gmpu_status gmpu_points_read(const char *path, gmpu_points **out) {
+GMPU_API gmpu_status gmpu_points_read_with(const char *path, double max_memory, gmpu_progress_fn fn, void *user,
+                                           gmpu_points **out) {
     return gmpu::api::guarded(nullptr, [&] {
         gmpu::api::require_arg(out, "out");
         *out = nullptr;
         gmpu::api::require_arg(path, "path");
+        if (!(max_memory == 0.0 || (max_memory >= 1e6 && max_memory <= 1e15)))
+            throw Error(GMPU_ERROR_INVALID_ARGUMENT,
+                        "max_memory = " + std::to_string(max_memory) + " is out of range: expected 0 or 1e6..1e15");
+        gmpu::Progress progress(fn, user, GMPU_STAGE_READ);
+        progress.report(0.0, true);
+        gmpu::io::ReadOptions options;
+        options.max_memory = max_memory;
+        options.progress = &progress;
         auto points = std::make_unique<gmpu_points>();
-        points->cloud = gmpu::io::read_points(path);
+        points->cloud = gmpu::io::read_points(path, options);
+        progress.report(1.0, true);
+        progress.throw_if_cancelled();
         *out = points.release();
     });
+}
+
+GMPU_API gmpu_status gmpu_points_read(const char *path, gmpu_points **out) {
+    return gmpu_points_read_with(path, 0.0, nullptr, nullptr, out);
 }
 
 GMPU_API gmpu_status gmpu_points_create(const double *xyz, const double *normals, size_t count,

@@ -15,18 +15,22 @@
 #include "api/input.hpp"
 #include "api/param_table.hpp"
 #include "api/statistics.hpp"
+#include "api/surface_parts.hpp"
 #include "core/parallel.hpp"
 #include "core/params.hpp"
 #include "core/progress.hpp"
 #include "core/release_memory.hpp"
 #include "fit/build_octree.hpp"
 #include "fit/noise_estimate.hpp"
+#include "geometry/clusters.hpp"
+#include "geometry/outliers.hpp"
 #include "geometry/point_set.hpp"
 #include "implicit/mpu_function.hpp"
 #include "implicit/surface_field.hpp"
 #include "implicit/winding_field.hpp"
 #include "mesh/polygonizer.hpp"
 #include "orient/orient.hpp"
+#include "orient/orient_memory.hpp"
 
 using gmpu::Error;
 using gmpu::api::guarded;
@@ -44,6 +48,9 @@ struct gmpu_surface {
     gmpu::Octree tree;
     gmpu::PointMeasures measures;      // oriented normals, areas, trust radii per point
     gmpu::WindingField winding;        // built from the measures; signs far regions
+    // Set when the points are spatially separated clusters: then each is a surface of its
+    // own, and points, tree, measures and winding above stay empty.
+    std::unique_ptr<gmpu::api::SurfaceParts> parts;
     gmpu_progress_fn progress_fn = nullptr;
     void *progress_user = nullptr;
     std::string last_error;
@@ -135,14 +142,39 @@ void finish_stage(gmpu::Progress &progress) {
     progress.throw_if_cancelled();
 }
 
+// The clusters' surfaces take every parameter of their owner's.
+void push_params(const gmpu::Params &p, gmpu::api::SurfaceParts &parts) {
+    for (int key = 1; key <= gmpu_param_count(); ++key)
+        parts.set_param(gmpu_param(key), gmpu::api::get_param(p, gmpu_param(key)));
+}
+
 template <class T>
 gmpu_status set_points(gmpu_surface *s, const T *xyz, size_t count, size_t stride) {
     return guarded(s ? &s->last_error : nullptr, [&] {
         require_arg(s, "surface");
         s->require_idle("gmpu_surface_set_points");
         gmpu::api::check_array(xyz, count, stride, 3 * sizeof(T), "xyz");
-        gmpu::api::InputPoints in = gmpu::api::input_points(xyz, count, stride, size_t(s->params.min_points));
+        const size_t min_points = size_t(s->params.min_points);
+        gmpu::OutlierScan scan = gmpu::find_outliers(xyz, count, stride);
+        const gmpu::Clusters groups = gmpu::find_clusters(xyz, count, stride, scan.outliers, min_points);
+        if (groups.count > 1) {
+            auto parts = std::make_unique<gmpu::api::SurfaceParts>(groups);
+            push_params(s->params, *parts);
+            parts->set_points(xyz, count, stride);
+            s->discard_fit();
+            s->points = gmpu::PointSet();
+            s->input_count = count;
+            s->outliers.clear();
+            s->outlier_nearest.clear();
+            s->input_normals.clear();
+            s->parts = std::move(parts);
+            s->stage = gmpu_surface::Stage::points;
+            return;
+        }
+        gmpu::api::InputPoints in =
+            gmpu::api::input_points(xyz, count, stride, min_points, std::move(scan), s->params.remove_outliers);
         s->discard_fit();
+        s->parts.reset();
         s->points = std::move(in.points);
         s->input_count = count;
         s->outliers = std::move(in.outliers);
@@ -162,6 +194,11 @@ gmpu_status set_normals(gmpu_surface *s, const T *nxyz, size_t count, size_t str
         if (count != s->input_count)
             throw Error(GMPU_ERROR_INVALID_INPUT, std::to_string(count) + " normals given for " +
                                                       std::to_string(s->input_count) + " points");
+        if (s->parts) {
+            s->parts->set_normals(nxyz, count, stride);
+            if (s->stage > gmpu_surface::Stage::fitted) s->stage = gmpu_surface::Stage::fitted;
+            return;
+        }
         std::vector<float> unit = gmpu::api::unit_normals(nxyz, count, stride, s->outliers);
         s->input_normals.swap(unit);
         if (s->stage > gmpu_surface::Stage::fitted) s->stage = gmpu_surface::Stage::fitted;
@@ -221,6 +258,11 @@ GMPU_API gmpu_status gmpu_surface_get_stat(const gmpu_surface *s, gmpu_stat key,
         require_arg(value, "value");
         s->require_idle("gmpu_surface_get_stat");
         gmpu::api::check_stat_key(key);
+        if (s->parts && key != GMPU_STAT_POINTS && key != GMPU_STAT_FIT_SECONDS && key != GMPU_STAT_ORIENT_SECONDS &&
+            key != GMPU_STAT_POLYGONIZE_SECONDS) {
+            *value = s->parts->stat(key);
+            return;
+        }
         const gmpu::api::StatSources from{s->input_count,   s->points,  s->stage >= gmpu_surface::Stage::fitted,
                                           s->tree,          s->orient_stats,
                                           s->seconds,       s->last_resolution,
@@ -260,6 +302,18 @@ GMPU_API gmpu_status gmpu_surface_fit(gmpu_surface *s) {
         auto t0 = Clock::now();
         gmpu::Progress progress(s->progress_fn ? progress_or_stop : nullptr, s, GMPU_STAGE_FIT);
         progress.report(0.0, true);
+        if (s->parts) {
+            // Each cluster's fit replaces its own as it goes: until all are done, the
+            // clusters do not share one fit, so a failed or cancelled fit leaves none.
+            s->discard_fit();
+            push_params(s->params, *s->parts);
+            s->parts->fit(progress_or_stop, s);
+            progress.report(1.0, true);
+            progress.throw_if_cancelled();
+            s->stage = gmpu_surface::Stage::fitted;
+            s->seconds[GMPU_STAGE_FIT] = since(t0);
+            return;
+        }
         const double noise = gmpu::estimate_noise(s->points, progress);
         const double epsilon = gmpu::effective_epsilon(s->points, s->params, noise);
         gmpu::Octree tree = gmpu::build_octree(s->points, s->params, epsilon, progress);
@@ -283,7 +337,17 @@ GMPU_API gmpu_status gmpu_surface_orient(gmpu_surface *s) {
         // Orient only writes the cells' signs and resets them first, so a cancelled or failed
         // orient leaves a fit that the next orient can use as it is.
         s->stage = gmpu_surface::Stage::fitted;
+        if (s->parts) {
+            push_params(s->params, *s->parts);
+            s->parts->orient(progress_or_stop, s);
+            progress.report(1.0, true);
+            progress.throw_if_cancelled();
+            s->stage = gmpu_surface::Stage::oriented;
+            s->seconds[GMPU_STAGE_ORIENT] = since(t0);
+            return;
+        }
         s->winding = gmpu::WindingField();
+        gmpu::check_orient_memory(s->tree, s->points, s->params.max_memory);
         gmpu::Octree &tree = s->tree;
         gmpu::OrientStats stats = gmpu::orient_octree(
             tree, s->points, s->input_normals.empty() ? nullptr : s->input_normals.data(), s->params, progress);
@@ -317,6 +381,7 @@ GMPU_API gmpu_status gmpu_surface_evaluate(const gmpu_surface *s, const double *
         for (size_t i = 0; i < 3 * count; ++i)
             if (!std::isfinite(xyz[i]))
                 throw Error(GMPU_ERROR_INVALID_INPUT, "query point " + std::to_string(i / 3) + " is NaN or infinite");
+        if (s->parts) return s->parts->evaluate(xyz, count, values, gradients);
         const gmpu::MpuFunction mpu(s->tree, s->params.level);
         const gmpu::SurfaceField f(mpu, s->points, s->measures, s->winding);
         const gmpu::Normalisation &norm = s->points.normalisation();
@@ -343,6 +408,7 @@ GMPU_API gmpu_status gmpu_surface_copy_normals(const gmpu_surface *s, double *ou
         if (count != s->input_count)
             throw Error(GMPU_ERROR_INVALID_ARGUMENT, "count " + std::to_string(count) + " differs from the " +
                                                          std::to_string(s->input_count) + " points");
+        if (s->parts) return s->parts->copy_normals(out, count);
         // An outlier takes the normal of the kept point nearest to it.
         size_t next_outlier = 0, kept = 0;
         for (size_t i = 0; i < count; ++i) {
@@ -365,6 +431,21 @@ GMPU_API gmpu_status gmpu_surface_polygonize(gmpu_surface *s, gmpu_mesh **out) {
         auto t0 = Clock::now();
         gmpu::Progress progress(s->progress_fn ? progress_or_stop : nullptr, s, GMPU_STAGE_POLYGONIZE);
         progress.report(0.0, true);
+        if (s->parts) {
+            push_params(s->params, *s->parts);
+            auto mesh = std::make_unique<gmpu_mesh>();
+            mesh->mesh = s->parts->polygonize(progress_or_stop, s);
+            if (double(mesh->mesh.triangle_count()) > s->params.max_triangles)
+                throw Error(GMPU_ERROR_LIMIT_EXCEEDED, "the clusters' meshes have " +
+                                                           std::to_string(mesh->mesh.triangle_count()) +
+                                                           " triangles together, over GMPU_PARAM_MAX_TRIANGLES");
+            progress.report(1.0, true);
+            progress.throw_if_cancelled();
+            s->last_resolution = int(s->parts->stat(GMPU_STAT_RESOLUTION));
+            s->seconds[GMPU_STAGE_POLYGONIZE] = since(t0);
+            *out = mesh.release();
+            return;
+        }
         int resolution = s->params.resolution > 0 ? s->params.resolution : gmpu::default_resolution(s->tree);
         const gmpu::MpuFunction mpu(s->tree, s->params.level);
         auto mesh = std::make_unique<gmpu_mesh>();

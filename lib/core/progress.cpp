@@ -10,6 +10,7 @@ const char *stage_name(gmpu_stage stage) {
         case GMPU_STAGE_FIT: return "fit";
         case GMPU_STAGE_ORIENT: return "orient";
         case GMPU_STAGE_POLYGONIZE: return "polygonize";
+        case GMPU_STAGE_READ: return "reading";
     }
     return "work";
 }

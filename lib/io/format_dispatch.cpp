@@ -1,9 +1,13 @@
 // The public entry points of io.hpp: pick the format from the extension, open the file
 // (a regular file, or an IO error), parse it, check the values; or validate, write through AtomicFile and commit.
+#include <algorithm>
 #include <cctype>
 #include <climits>
 #include <cmath>
+#include <cstdio>
 #include <string>
+
+#include "core/memory_budget.hpp"
 
 #include "io/atomic_file.hpp"
 #include "io/errors.hpp"
@@ -51,9 +55,26 @@ Format format_of(const std::string &path, const Accepts &a) {
              a.purpose + " (expected " + a.list + ")");
 }
 
+// What reading `points` points takes at most, on top of `held` bytes of the file in memory:
+// positions and normals as doubles. Over the budget: LIMIT_EXCEEDED, before the arrays or
+// the body exist.
+constexpr double kBytesPerPoint = 6 * sizeof(double);
+constexpr size_t kLineBufferBytes = size_t{1} << 20;  // a text reader's chunk
+void check_read_memory(const std::string &path, uint64_t points, double held, double budget) {
+    const double estimate = held + double(points) * kBytesPerPoint;
+    if (estimate <= budget) return;
+    char text[256];
+    std::snprintf(text, sizeof text,
+                  "reading it needs about %.3g bytes (%llu points), over the memory budget of %.3g bytes "
+                  "(GMPU_PARAM_MAX_MEMORY)",
+                  estimate, static_cast<unsigned long long>(points), budget);
+    fail(GMPU_ERROR_LIMIT_EXCEEDED, path, text);
+}
+
 // PLY: its header first, checked, and only then the body (read whole: binary bodies are
-// parsed in place). A 2 GB file that is not a PLY fails on its first bytes.
-std::string read_ply_bytes(InputFile &file, const std::string &path) {
+// parsed in place). A 2 GB file that is not a PLY fails on its first bytes; one whose
+// header claims more points than the budget holds, before its body is read.
+std::string read_ply_bytes(InputFile &file, const std::string &path, double budget) {
     std::string bytes;
     size_t want = size_t{64} << 10;
     for (;;) {
@@ -67,21 +88,40 @@ std::string read_ply_bytes(InputFile &file, const std::string &path) {
         }
         const bool at_end = got < bytes.size();
         bytes.resize(got);
-        if (check_ply_header(bytes.data(), bytes.size(), path) || at_end) break;
+        uint64_t vertices = 0;
+        if (check_ply_header(bytes.data(), bytes.size(), path, &vertices)) {
+            // Counted up to what the file's bytes can hold (a vertex takes three at least):
+            // a header that claims more is a truncated file, which the parse reports.
+            check_read_memory(path, std::min<uint64_t>(vertices, file.size() / 3), double(file.size()), budget);
+            break;
+        }
+        if (at_end) break;
         want = bytes.size();  // doubling: a long header is scanned a bounded number of times
     }
     file.read_rest(bytes);
     return bytes;
 }
 
-Parsed parse(Format f, InputFile &file, const std::string &path, Want want) {
+// Progress: the bytes read, then parsed, each pass a share of the whole (the values' check
+// after it takes the last tenth).
+Parsed parse(Format f, InputFile &file, const std::string &path, Want want, const ReadOptions &options,
+             ReadTicker &ticker) {
+    const double budget = options.max_memory > 0.0 ? options.max_memory : default_memory_budget();
+    file.set_ticker(&ticker);
     if (f == Format::ply) {
-        const std::string bytes = read_ply_bytes(file, path);
-        return parse_ply_buffer(bytes.data(), bytes.size(), path, want);
+        ticker.pass(0.0, 0.45);
+        const std::string bytes = read_ply_bytes(file, path, budget);
+        file.set_ticker(nullptr);
+        ticker.pass(0.45, 0.45);
+        return parse_ply_buffer(bytes.data(), bytes.size(), path, want, &ticker);
     }
     // Text formats: read in chunks, the arrays sized once from a count of the lines, so a
-    // text file costs the memory of its numbers, not of its bytes as well.
-    const uint64_t line_count = f == Format::off ? 0 : count_lines(file, path);
+    // text file costs the memory of its numbers, not of its bytes as well. The count (an
+    // upper bound on the points) is checked against the budget before the parse.
+    ticker.pass(0.0, 0.2);
+    const uint64_t line_count = count_lines(file, path);
+    check_read_memory(path, line_count, double(kLineBufferBytes), budget);
+    ticker.pass(0.2, 0.7);
     LineReader lines(file, path);
     switch (f) {
         case Format::xyz: return parse_xyz_lines(lines, path, line_count);
@@ -92,35 +132,41 @@ Parsed parse(Format f, InputFile &file, const std::string &path, Want want) {
     fail(GMPU_ERROR_INTERNAL, path, "unknown format");
 }
 
-void check_finite(const std::vector<double> &v, const std::string &name, const char *what) {
-    for (size_t i = 0; i < v.size(); ++i)
+void check_finite(const std::vector<double> &v, const std::string &name, const char *what,
+                  const ReadTicker *ticker) {
+    constexpr size_t kTickValues = size_t{1} << 16;
+    for (size_t i = 0; i < v.size(); ++i) {
+        if (ticker && i % kTickValues == 0) ticker->at(double(i) / double(v.size()));
         if (!std::isfinite(v[i]))
             fail(GMPU_ERROR_INVALID_INPUT, name, "vertex " + std::to_string(i / 3) + " has a non-finite " + what +
                                                      " (" + std::to_string(v[i]) + ")");
+    }
 }
 
 }  // namespace
 
-void check_points(const Parsed &parsed, const std::string &name) {
+void check_points(const Parsed &parsed, const std::string &name, const ReadTicker *ticker) {
     if (parsed.positions.empty()) fail(GMPU_ERROR_INVALID_INPUT, name, "no points");
-    check_finite(parsed.positions, name, "coordinate");
-    check_finite(parsed.normals, name, "normal");
+    check_finite(parsed.positions, name, "coordinate", ticker);
+    check_finite(parsed.normals, name, "normal", ticker);
 }
 
 void check_mesh(const Parsed &parsed, const std::string &name) {
     if (parsed.positions.empty()) fail(GMPU_ERROR_INVALID_INPUT, name, "no vertices");
-    check_finite(parsed.positions, name, "coordinate");
+    check_finite(parsed.positions, name, "coordinate", nullptr);
 }
 
 }  // namespace detail
 
 using detail::fail;
 
-PointCloud read_points(const std::string &path) {
+PointCloud read_points(const std::string &path, const ReadOptions &options) {
     const detail::Format f = detail::format_of(path, detail::reading_points);
     detail::InputFile file(path);
-    detail::Parsed parsed = detail::parse(f, file, path, detail::Want::points);
-    detail::check_points(parsed, path);
+    detail::ReadTicker ticker{options.progress};
+    detail::Parsed parsed = detail::parse(f, file, path, detail::Want::points, options, ticker);
+    ticker.pass(0.9, 0.1);
+    detail::check_points(parsed, path, &ticker);
     PointCloud cloud;
     cloud.positions = std::move(parsed.positions);
     cloud.normals = std::move(parsed.normals);
@@ -130,7 +176,8 @@ PointCloud read_points(const std::string &path) {
 MeshData read_mesh(const std::string &path) {
     const detail::Format f = detail::format_of(path, detail::reading_meshes);
     detail::InputFile file(path);
-    detail::Parsed parsed = detail::parse(f, file, path, detail::Want::mesh);
+    detail::ReadTicker ticker;
+    detail::Parsed parsed = detail::parse(f, file, path, detail::Want::mesh, ReadOptions{}, ticker);
     detail::check_mesh(parsed, path);
     MeshData mesh;
     mesh.vertices = std::move(parsed.positions);

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "io/io.hpp"
+#include "io/read_ticker.hpp"
 
 namespace gmpu::io {
 
@@ -27,7 +28,9 @@ struct Parsed {
 
 enum class Want { points, mesh };  // mesh: faces are parsed (and checked) too
 
-Parsed parse_ply_buffer(const char *data, size_t size, const std::string &name, Want want);
+// `ticker` (may be null) hears how much of the buffer is parsed, every thousand records.
+Parsed parse_ply_buffer(const char *data, size_t size, const std::string &name, Want want,
+                        const ReadTicker *ticker = nullptr);
 Parsed parse_xyz_buffer(const char *data, size_t size, const std::string &name);
 Parsed parse_off_buffer(const char *data, size_t size, const std::string &name, Want want);
 Parsed parse_obj_buffer(const char *data, size_t size, const std::string &name, Want want);
@@ -41,12 +44,13 @@ Parsed parse_obj_lines(LineReader &lines, const std::string &name, Want want, ui
 
 // PLY: the header alone, checked (GMPU_ERROR_PARSE / UNSUPPORTED as parse_ply_buffer), so
 // that a file that is not a PLY fails before its body is read. `data` must hold the whole
-// header; true if it does (an "end_header" line was found).
-bool check_ply_header(const char *data, size_t size, const std::string &name);
+// header; true if it does (an "end_header" line was found), with *vertices (when given) the
+// vertex count the header claims.
+bool check_ply_header(const char *data, size_t size, const std::string &name, uint64_t *vertices = nullptr);
 
 // INVALID_INPUT for a non-finite coordinate or normal (naming the vertex index) and for
 // an empty result ("no points" / "no vertices").
-void check_points(const Parsed &parsed, const std::string &name);
+void check_points(const Parsed &parsed, const std::string &name, const ReadTicker *ticker = nullptr);
 void check_mesh(const Parsed &parsed, const std::string &name);
 
 // Writers append the whole file to `out`; the caller commits it. `mesh.triangles` is

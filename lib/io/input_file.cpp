@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <vector>
@@ -44,15 +45,23 @@ InputFile::InputFile(const std::string &path) : path_(path) {
     size_ = static_cast<uint64_t>(st.st_size);
 }
 
+namespace {
+// One read's most: a text reader parses this much in about ten milliseconds, between two
+// progress polls.
+constexpr size_t kMaxRead = size_t{128} << 10;
+}  // namespace
+
 InputFile::~InputFile() {
     if (fd_ >= 0) ::close(fd_);
 }
 
 size_t InputFile::read(char *dst, size_t n) {
+    n = std::min(n, kMaxRead);
     for (;;) {
         const ssize_t got = ::read(fd_, dst, n);
         if (got >= 0) {
             consumed_ += static_cast<uint64_t>(got);
+            if (ticker_) ticker_->at(size_ > 0 ? std::min(1.0, double(consumed_) / double(size_)) : 1.0);
             return static_cast<size_t>(got);
         }
         if (errno != EINTR) fail(GMPU_ERROR_IO, path_, "cannot read: " + system_reason(errno));
@@ -66,15 +75,11 @@ void InputFile::rewind() {
 
 void InputFile::read_rest(std::string &bytes) {
     // The size is a hint (the file may change while read): read to the end regardless.
-    size_t got = bytes.size();
-    bytes.resize(got + static_cast<size_t>(unread()) + 1);
-    for (;;) {
-        if (got == bytes.size()) bytes.resize(2 * bytes.size());
-        const size_t n = read(&bytes[got], bytes.size() - got);
-        if (n == 0) break;
-        got += n;
-    }
-    bytes.resize(got);
+    // Appended a chunk at a time, so that the pages are touched (and faulted in) between
+    // two reads, not all at once by a resize.
+    bytes.reserve(bytes.size() + static_cast<size_t>(unread()));
+    std::vector<char> chunk(kMaxRead);
+    while (const size_t n = read(chunk.data(), chunk.size())) bytes.append(chunk.data(), n);
 }
 
 uint64_t count_lines(InputFile &file, const std::string &path) {

@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <string>
 
+#include "io/read_ticker.hpp"
 #include "io/text_scan.hpp"
 
 namespace gmpu::io::detail {
@@ -29,11 +30,16 @@ public:
     // Appends the rest of the file to `bytes`.
     void read_rest(std::string &bytes);
 
+    // Every read then reports the share of the file read so far (reads are at most a
+    // 128 KiB each, so the reports keep their cadence).
+    void set_ticker(const ReadTicker *ticker) { ticker_ = ticker; }
+
 private:
     std::string path_;
     int fd_ = -1;
     uint64_t size_ = 0;
     uint64_t consumed_ = 0;
+    const ReadTicker *ticker_ = nullptr;
 };
 
 // Lines of the file (line-based text formats), counted in one pass over it: what lets a

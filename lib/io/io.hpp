@@ -10,7 +10,18 @@
 #include <string>
 #include <vector>
 
+namespace gmpu {
+class Progress;
+}
+
 namespace gmpu::io {
+
+// How a file is read: the memory budget (bytes; 0 is the library's default, half the
+// physical memory) and where progress goes (null: nowhere; a cancel there stops the read).
+struct ReadOptions {
+    double max_memory = 0.0;
+    Progress *progress = nullptr;
+};
 
 struct PointCloud {
     std::vector<double> positions;  // 3 per point
@@ -43,9 +54,13 @@ struct MeshView {
 //                 the double range ("1e999"), a header count the file does not hold
 //                 ("expected N vertices, file ends after M"), a face index out of range;
 //   INVALID_INPUT no points, or a NaN / infinite coordinate or normal (binary, or "nan" /
-//                 "inf" in text), naming the vertex index.
+//                 "inf" in text), naming the vertex index;
+//   LIMIT_EXCEEDED what the points would take in memory (from the PLY header's vertex count
+//                 and the file's size, or a text file's line count) is over the budget:
+//                 found before the body is read or parsed;
+//   CANCELLED     the progress callback asked to stop.
 // Per format: lib/io/ply_reader.cpp, xyz_format.cpp, off_format.cpp, obj_format.cpp.
-PointCloud read_points(const std::string &path);
+PointCloud read_points(const std::string &path, const ReadOptions &options = {});
 
 // Vertices and faces of .off, .obj or .ply meshes (used by tests and the benchmark).
 MeshData read_mesh(const std::string &path);

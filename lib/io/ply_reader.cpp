@@ -213,8 +213,9 @@ struct Wanted {
 
 class Body {
 public:
-    Body(const char *data, size_t size, const Header &h, const std::string &name, Want want)
-        : h_(h), name_(name), want_(want), p_(reinterpret_cast<const unsigned char *>(data) + h.body_offset),
+    Body(const char *data, size_t size, const Header &h, const std::string &name, Want want, const ReadTicker *ticker)
+        : h_(h), name_(name), want_(want), ticker_(ticker), size_(size),
+          p_(reinterpret_cast<const unsigned char *>(data) + h.body_offset),
           end_(reinterpret_cast<const unsigned char *>(data) + size),
           tokens_(data + h.body_offset, data + size, h.body_line),
           swap_(h.encoding != Encoding::ascii && (h.encoding == Encoding::little) != host_is_little) {}
@@ -223,6 +224,13 @@ public:
 
 private:
     size_t left() const { return static_cast<size_t>(end_ - p_); }
+    // Every kTickRecords records: the share of the buffer parsed (`ahead`: bytes past p_).
+    static constexpr uint64_t kTickRecords = 1024;
+    void tick(uint64_t item, size_t ahead = 0) const {
+        if (!ticker_ || item % kTickRecords != 0) return;
+        const size_t rest = h_.encoding == Encoding::ascii ? tokens_.remaining() : left() - ahead;
+        ticker_->at(1.0 - double(rest) / double(std::max<size_t>(size_, 1)));
+    }
     [[noreturn]] void truncated(const Element &e, uint64_t done) const {
         std::string what = e.name == "vertex" ? "vertices" : quoted(e.name) + " elements";
         fail(GMPU_ERROR_PARSE, name_, "expected " + std::to_string(e.count) + " " + what +
@@ -241,6 +249,8 @@ private:
     const Header &h_;
     const std::string &name_;
     Want want_;
+    const ReadTicker *ticker_;
+    size_t size_;
     const unsigned char *p_;
     const unsigned char *end_;
     TokenReader tokens_;
@@ -360,13 +370,16 @@ void Body::vertices(const Element &e, Parsed &out) {
             for (int pi = 0; pi < w.prop[k]; ++pi) offset[k] += size_of(e.props[static_cast<size_t>(pi)].type);
             type[k] = e.props[static_cast<size_t>(w.prop[k])].type;
         }
-        out.positions.resize(3 * n);
-        if (w.n == 6) out.normals.resize(3 * n);
+        // Reserved, then filled record by record: the pages are touched as the ticks go.
+        out.positions.reserve(3 * n);
+        if (w.n == 6) out.normals.reserve(3 * n);
+        double v[6];
         for (size_t i = 0; i < n; ++i) {
+            tick(i, i * rec);
             const unsigned char *r = p_ + i * rec;
-            for (size_t k = 0; k < 3; ++k) out.positions[3 * i + k] = load_scalar(r + offset[k], type[k], swap_);
-            if (w.n == 6)
-                for (size_t k = 0; k < 3; ++k) out.normals[3 * i + k] = load_scalar(r + offset[3 + k], type[3 + k], swap_);
+            for (size_t k = 0; k < w.n; ++k) v[k] = load_scalar(r + offset[k], type[k], swap_);
+            out.positions.insert(out.positions.end(), v, v + 3);
+            if (w.n == 6) out.normals.insert(out.normals.end(), v + 3, v + 6);
         }
         p_ += n * rec;
         return;
@@ -381,6 +394,7 @@ void Body::vertices(const Element &e, Parsed &out) {
     if (w.n == 6) out.normals.reserve(3 * reserve);
     double v[6];
     for (uint64_t i = 0; i < e.count; ++i) {
+        tick(i);
         record(e, w, v, -1, i, [](uint64_t) {});
         out.positions.insert(out.positions.end(), v, v + 3);
         if (w.n == 6) out.normals.insert(out.normals.end(), v + 3, v + 6);
@@ -393,6 +407,7 @@ void Body::faces(const Element &e, int list_prop, Parsed &out) {
     out.triangles.reserve(3 * static_cast<size_t>(std::min<uint64_t>(e.count, cap)));
     Wanted none;
     for (uint64_t i = 0; i < e.count; ++i) {
+        tick(i);
         record(e, none, nullptr, list_prop, i, [&](uint64_t len) {
             if (len < 3)
                 fail(GMPU_ERROR_PARSE, name_, "face " + std::to_string(i) + " has " + std::to_string(len) +
@@ -411,7 +426,10 @@ void Body::skip(const Element &e) {
         return;
     }
     Wanted none;
-    for (uint64_t i = 0; i < e.count; ++i) record(e, none, nullptr, -1, i, [](uint64_t) {});
+    for (uint64_t i = 0; i < e.count; ++i) {
+        tick(i);
+        record(e, none, nullptr, -1, i, [](uint64_t) {});
+    }
 }
 
 Parsed Body::run() {
@@ -442,7 +460,7 @@ Parsed Body::run() {
 
 }  // namespace
 
-bool check_ply_header(const char *data, size_t size, const std::string &name) {
+bool check_ply_header(const char *data, size_t size, const std::string &name, uint64_t *vertices) {
     // The magic first: a file that is not a PLY fails on its first bytes.
     LineReader lines(data, data + size, name);
     std::string_view first;
@@ -454,16 +472,21 @@ bool check_ply_header(const char *data, size_t size, const std::string &name) {
          (p = static_cast<const char *>(std::memchr(p, '\n', size - static_cast<size_t>(p - data))));) {
         ++p;
         if (static_cast<size_t>(data + size - p) >= 10 && std::memcmp(p, "end_header", 10) == 0) {
-            parse_header(data, size, name);
+            const Header h = parse_header(data, size, name);
+            if (vertices) {
+                *vertices = 0;
+                for (const Element &e : h.elements)
+                    if (e.name == "vertex") *vertices = e.count;
+            }
             return true;
         }
     }
     return false;
 }
 
-Parsed parse_ply_buffer(const char *data, size_t size, const std::string &name, Want want) {
+Parsed parse_ply_buffer(const char *data, size_t size, const std::string &name, Want want, const ReadTicker *ticker) {
     Header h = parse_header(data, size, name);
-    return Body(data, size, h, name, want).run();
+    return Body(data, size, h, name, want, ticker).run();
 }
 
 }  // namespace gmpu::io::detail

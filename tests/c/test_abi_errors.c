@@ -415,6 +415,7 @@ static void test_parameters(void **state) {
         {GMPU_PARAM_MAX_TRIANGLES, "GMPU_PARAM_MAX_TRIANGLES", {0, 3e9, 0.5, NAN, -5, INFINITY}, 6, 1e6},
         {GMPU_PARAM_NOISE_SCALE, "GMPU_PARAM_NOISE_SCALE", {-0.1, 20.5, NAN, INFINITY, 0, 0}, 4, 2},
         {GMPU_PARAM_MAX_MEMORY, "GMPU_PARAM_MAX_MEMORY", {0, 999999, 2e15, NAN, -1, INFINITY}, 6, 5e9},
+        {GMPU_PARAM_REMOVE_OUTLIERS, "GMPU_PARAM_REMOVE_OUTLIERS", {2, -1, 0.5, NAN, 0, 0}, 4, 0},
     };
     for (size_t c = 0; c < sizeof cases / sizeof *cases; ++c) {
         double before = -1, after = -1;
@@ -791,14 +792,130 @@ static void test_outliers_set_aside(void **state) {
     gmpu_mesh_destroy(reference);
     gmpu_surface_destroy(clean);
 
-    /* Two clusters a million sizes apart: not "collinear", but a message saying what it is. */
-    for (size_t i = 0; i < N_GOOD; ++i)
-        for (int d = 0; d < 3; ++d) xyz[3 * i + d] = g_good[3 * i + d] + (i % 2 ? 1e6 : 0.0);
+    /* GMPU_PARAM_REMOVE_OUTLIERS = 0: found and counted, but kept: they set the box again. */
     gmpu_surface *s = new_surface();
-    check_failure(gmpu_surface_set_points_f64(s, xyz, N_GOOD, 0), GMPU_ERROR_INVALID_INPUT, "clusters");
+    double v = -1, outliers = 0, diag = 0;
+    assert_ok(gmpu_surface_get_param(s, GMPU_PARAM_REMOVE_OUTLIERS, &v));
+    assert_true(v == 1);
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_REMOVE_OUTLIERS, 0));
+    for (int d = 0; d < 3; ++d) xyz[3 * N_GOOD + d] = kCentre[d] + 100, xyz[3 * N_GOOD + 3 + d] = kCentre[d] - 100;
+    assert_ok(gmpu_surface_set_points_f64(s, xyz, n, 0));
+    assert_ok(gmpu_surface_get_stat(s, GMPU_STAT_OUTLIERS, &outliers));
+    assert_ok(gmpu_surface_get_stat(s, GMPU_STAT_BBOX_DIAGONAL, &diag));
+    assert_true(outliers == 2 && diag > 300);
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_REMOVE_OUTLIERS, 1));
+    assert_ok(gmpu_surface_set_points_f64(s, xyz, n, 0));
+    assert_ok(gmpu_surface_get_stat(s, GMPU_STAT_BBOX_DIAGONAL, &diag));
+    assert_true(diag == clean_diag);
+    check_usable_and_destroy(s);
     free(xyz);
     free(normals);
-    check_usable_and_destroy(s);
+}
+
+/* Vertices of m within `radius` × (1 ± tolerance) of c, and every triangle's three vertices on
+ * the same side of x = split: the count of vertices near c. */
+static size_t sphere_vertices(const gmpu_mesh *m, const double c[3], double radius, double split, int left) {
+    const double *v = gmpu_mesh_vertices(m);
+    const uint32_t *t = gmpu_mesh_triangles(m);
+    for (size_t i = 0; i < gmpu_mesh_triangle_count(m); ++i)
+        for (int k = 1; k < 3; ++k)
+            assert_true((v[3 * t[3 * i]] < split) == (v[3 * t[3 * i + k]] < split)); /* no bridge */
+    size_t n = 0;
+    for (size_t i = 0; i < gmpu_mesh_vertex_count(m); ++i) {
+        const double *p = v + 3 * i;
+        if ((p[0] < split) != left) continue;
+        const double r = sqrt((p[0] - c[0]) * (p[0] - c[0]) + (p[1] - c[1]) * (p[1] - c[1]) + (p[2] - c[2]) * (p[2] - c[2]));
+        if (fabs(r - radius) > 0.03 * radius) fail_msg("vertex %zu at %g from the centre of a sphere of radius %g", i, r, radius);
+        ++n;
+    }
+    return n;
+}
+
+/* Progress of a clustered surface: one stage from 0 to 1 across its clusters; a cancel in
+ * the second cluster's share stops the whole stage. */
+typedef struct {
+    double last, cancel_at;
+    int decreasing, calls;
+} cluster_watch;
+static int on_cluster_progress(void *user, gmpu_stage stage, double fraction) {
+    cluster_watch *w = user;
+    (void)stage;
+    w->decreasing |= fraction < w->last;
+    w->last = fraction;
+    ++w->calls;
+    return w->cancel_at > 0 && fraction >= w->cancel_at;
+}
+
+/* Clusters far apart (a unit sphere and one of radius 1000 a million units away): each is
+ * reconstructed at its own scale, exactly as if alone (the merged mesh is the two meshes one
+ * after the other), normals come back in input order, and evaluate answers with the nearest
+ * cluster's field. They used to be refused ("clusters this far apart"); at one scale the small
+ * sphere would be far below one grid cube. */
+static void test_separate_clusters(void **state) {
+    (void)state;
+    const double far_centre[3] = {1e6, 3, -2};
+    double *big = robust_sphere(N_GOOD, far_centre, 1000.0, 5);
+    double *xyz = malloc(6 * N_GOOD * sizeof *xyz), *normals = malloc(6 * N_GOOD * sizeof *normals);
+    /* Interleaved, so that each cluster's points are spread through the input. */
+    for (size_t i = 0; i < 2 * N_GOOD; ++i) memcpy(xyz + 3 * i, (i % 2 ? big : g_good) + 3 * (i / 2), 3 * sizeof *xyz);
+    gmpu_surface *alone_small = new_surface(), *alone_big = new_surface(), *s = new_surface();
+    gmpu_mesh *small_mesh = robust_reconstruct(alone_small, g_good, N_GOOD);
+    gmpu_mesh *big_mesh = robust_reconstruct(alone_big, big, N_GOOD);
+    gmpu_mesh *m = robust_reconstruct(s, xyz, 2 * N_GOOD);
+    const char *problem = robust_mesh_problem(m);
+    if (problem) fail_msg("merged mesh: %s", problem);
+    const double split = 5e5;
+    assert_true(sphere_vertices(m, kCentre, 1.0, split, 1) > 100);
+    assert_true(sphere_vertices(m, far_centre, 1000.0, split, 0) > 100);
+    /* Each cluster exactly as reconstructed alone, in the order of their first points. */
+    const size_t ns = gmpu_mesh_vertex_count(small_mesh), nb = gmpu_mesh_vertex_count(big_mesh);
+    assert_int_equal(gmpu_mesh_vertex_count(m), ns + nb);
+    assert_int_equal(gmpu_mesh_triangle_count(m), gmpu_mesh_triangle_count(small_mesh) + gmpu_mesh_triangle_count(big_mesh));
+    assert_memory_equal(gmpu_mesh_vertices(m), gmpu_mesh_vertices(small_mesh), 3 * ns * sizeof(double));
+    assert_memory_equal(gmpu_mesh_vertices(m) + 3 * ns, gmpu_mesh_vertices(big_mesh), 3 * nb * sizeof(double));
+    double components = 0, points = 0, diag = 0;
+    assert_ok(gmpu_surface_get_stat(s, GMPU_STAT_COMPONENTS, &components));
+    assert_ok(gmpu_surface_get_stat(s, GMPU_STAT_POINTS, &points));
+    assert_ok(gmpu_surface_get_stat(s, GMPU_STAT_BBOX_DIAGONAL, &diag));
+    assert_true(components == 2 && points == 2 * N_GOOD && diag > 1e6);
+    /* Normals in input order: outward on each sphere. */
+    assert_ok(gmpu_surface_copy_normals(s, normals, 2 * N_GOOD));
+    for (size_t i = 0; i < 2 * N_GOOD; ++i) {
+        const double *c = i % 2 ? far_centre : kCentre, r = i % 2 ? 1000.0 : 1.0, *p = xyz + 3 * i, *n = normals + 3 * i;
+        const double dot = ((p[0] - c[0]) * n[0] + (p[1] - c[1]) * n[1] + (p[2] - c[2]) * n[2]) / r;
+        if (dot < 0.9) fail_msg("normal %zu: %g along the outward radius", i, dot);
+    }
+    /* The field: inside each sphere positive, on it about zero, in its own units. */
+    const double q[12] = {kCentre[0], kCentre[1], kCentre[2], kCentre[0] + 1, kCentre[1], kCentre[2],
+                          far_centre[0], far_centre[1], far_centre[2], far_centre[0], far_centre[1] + 1000, far_centre[2]};
+    double f[4], g[12];
+    assert_ok(gmpu_surface_evaluate(s, q, 4, f, g));
+    assert_true(f[0] > 0.5 && fabs(f[1]) < 0.05 && f[2] > 500 && fabs(f[3]) < 50);
+    assert_true(g[3] < -0.5 && g[10] < -0.5); /* the field falls outward */
+    /* Input normals go to their clusters too. */
+    assert_ok(gmpu_surface_set_normals_f64(s, normals, 2 * N_GOOD, 0));
+    check_failure(gmpu_surface_evaluate(s, q, 1, f, NULL), GMPU_ERROR_WRONG_ORDER, "orient");
+    assert_ok(gmpu_surface_orient(s));
+    /* One fit from 0 to 1 over both clusters; cancelled in the second, it is cancelled. */
+    cluster_watch w = {0, 0, 0, 0};
+    assert_ok(gmpu_surface_set_progress(s, on_cluster_progress, &w));
+    assert_ok(gmpu_surface_fit(s));
+    assert_true(!w.decreasing && w.last == 1.0 && w.calls >= 3);
+    cluster_watch stop = {0, 0.75, 0, 0};
+    assert_ok(gmpu_surface_set_progress(s, on_cluster_progress, &stop));
+    check_failure(gmpu_surface_fit(s), GMPU_ERROR_CANCELLED, "cluster 2 of 2");
+    assert_ok(gmpu_surface_set_progress(s, NULL, NULL));
+    /* The clusters no longer share one fit: none is kept (one surface keeps its old one). */
+    check_failure(gmpu_surface_orient(s), GMPU_ERROR_WRONG_ORDER, "gmpu_surface_fit");
+    gmpu_mesh_destroy(m);
+    gmpu_mesh_destroy(small_mesh);
+    gmpu_mesh_destroy(big_mesh);
+    gmpu_surface_destroy(alone_small);
+    gmpu_surface_destroy(alone_big);
+    free(big);
+    free(xyz);
+    free(normals);
+    check_usable_and_destroy(s); /* back to one cluster */
 }
 
 /* Counts whose byte sizes overflow size_t are rejected before any read. */
@@ -868,6 +985,7 @@ int main(void) {
         cmocka_unit_test(test_overflowing_counts),
         cmocka_unit_test(test_normals_of_any_length),
         cmocka_unit_test(test_outliers_set_aside),
+        cmocka_unit_test(test_separate_clusters),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -241,7 +241,7 @@ static void check_after_cancel(gmpu_surface *s, gmpu_stage stage, gmpu_mesh *mes
     assert_non_null(strstr(gmpu_surface_last_error(s), "GMPU_ERROR_CANCELLED"));
     assert_non_null(strstr(gmpu_last_error(), stage_name(stage)));
     assert_true(cells == cells_before); /* no partial octree; a fit done before is kept */
-    switch (stage) {
+    switch ((int)stage) {
         case GMPU_STAGE_FIT:
             if (cells_before == 0) check_failure(gmpu_surface_orient(s), GMPU_ERROR_WRONG_ORDER, "gmpu_surface_fit");
             break;

@@ -7,8 +7,10 @@
 #include <stdint.h>
 #include <cmocka.h>
 
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
+#include <time.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -163,6 +165,134 @@ static void test_points_read_errors(void **state) {
     remove(obj);
 }
 
+/* The memory budget bounds reading: a file whose points would not fit is refused before its
+ * body is read — a sparse PLY whose header agrees with its size, a text file by its line
+ * count — with a message naming the estimate and the budget. */
+static void test_points_read_budget(void **state) {
+    (void)state;
+    gmpu_points *p = (gmpu_points *)&p;
+    const char *ply = scratch_path("sparse.ply");
+    const char *header = "ply\nformat binary_little_endian 1.0\nelement vertex 5592405\nproperty float x\n"
+                         "property float y\nproperty float z\nend_header\n";
+    put(ply, header);
+    assert_int_equal(truncate(ply, (off_t)(strlen(header) + 5592405ull * 12)), 0); /* 64 MB of holes */
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t0);
+    check_failure(gmpu_points_read_with(ply, 1e8, NULL, NULL, &p), GMPU_ERROR_LIMIT_EXCEEDED, "5592405 points");
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t1);
+    assert_null(p);
+    assert_non_null(strstr(gmpu_last_error(), "memory budget of 1e+08 bytes"));
+    assert_non_null(strstr(gmpu_last_error(), ply));
+    /* Refused from the header: far less CPU than reading 64 MB and converting 5.6M points. */
+    const double cpu = (double)(t1.tv_sec - t0.tv_sec) + 1e-9 * (double)(t1.tv_nsec - t0.tv_nsec);
+    if (cpu > 0.05 && getenv("GMPU_TEST_QUICK") == NULL) fail_msg("the refused read took %.3f s of CPU", cpu);
+    remove(ply);
+
+    const char *xyz = scratch_path("many.xyz");
+    FILE *f = fopen(xyz, "wb");
+    assert_non_null(f);
+    for (int i = 0; i < 100000; ++i) fprintf(f, "%d 0 1\n", i);
+    fclose(f);
+    check_failure(gmpu_points_read_with(xyz, 1e6, NULL, NULL, &p), GMPU_ERROR_LIMIT_EXCEEDED, "100000 points");
+    assert_null(p);
+    /* Within the budget (and at the default, 0), the same file reads. */
+    assert_int_equal(gmpu_points_read_with(xyz, 1e8, NULL, NULL, &p), GMPU_OK);
+    assert_int_equal(gmpu_points_count(p), 100000);
+    gmpu_points_destroy(p);
+    assert_int_equal(gmpu_points_read_with(xyz, 0, NULL, NULL, &p), GMPU_OK);
+    gmpu_points_destroy(p);
+    /* A budget out of range is a bad argument. */
+    const double bad[] = {-1, 5, 999999, 2e15, NAN, INFINITY};
+    for (size_t k = 0; k < sizeof bad / sizeof *bad; ++k) {
+        p = (gmpu_points *)&p;
+        check_failure(gmpu_points_read_with(xyz, bad[k], NULL, NULL, &p), GMPU_ERROR_INVALID_ARGUMENT, "max_memory");
+        assert_null(p);
+    }
+    remove(xyz);
+}
+
+/* ---- reading reports progress and stops on cancel ---- */
+
+typedef struct {
+    double last_cpu, max_gap, last_fraction, cancel_at, cancelled_cpu;
+    int reports, decreasing, wrong_stage;
+} read_watch;
+
+static double thread_cpu(void) {
+    struct timespec t;
+    clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+    return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
+}
+
+static int on_read_progress(void *user, gmpu_stage stage, double fraction) {
+    read_watch *w = user;
+    const double now = thread_cpu();
+    if (w->reports > 0 && now - w->last_cpu > w->max_gap) w->max_gap = now - w->last_cpu;
+    w->last_cpu = now;
+    w->wrong_stage |= stage != GMPU_STAGE_READ;
+    w->decreasing |= fraction < w->last_fraction;
+    w->last_fraction = fraction;
+    ++w->reports;
+    if (w->cancel_at > 0 && fraction >= w->cancel_at) {
+        w->cancelled_cpu = now;
+        return 1;
+    }
+    return 0;
+}
+
+/* A large .xyz and a large binary PLY: a report every 50 ms of the calling thread's CPU, the
+ * fraction rising to 1; a cancel (in the count, in the parse) returns CANCELLED within 100 ms
+ * of CPU, with no points. */
+static void test_points_read_progress_and_cancel(void **state) {
+    (void)state;
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+    const int timing = 0; /* instrumented: the promises are for optimised builds */
+#else
+    const int timing = getenv("GMPU_TEST_QUICK") == NULL;
+#endif
+    const size_t n = getenv("GMPU_TEST_QUICK") ? 20000 : 1000000; /* valgrind: small, no timing */
+    const char *xyz = scratch_path("large.xyz"), *ply = scratch_path("large.ply");
+    FILE *f = fopen(xyz, "wb");
+    assert_non_null(f);
+    for (size_t i = 0; i < n; ++i) fprintf(f, "%.6f %.6f %.6f\n", sin((double)i), cos(0.5 * (double)i), 1e-6 * (double)i);
+    fclose(f);
+    f = fopen(ply, "wb");
+    assert_non_null(f);
+    fprintf(f, "ply\nformat binary_little_endian 1.0\nelement vertex %zu\nproperty float x\nproperty float y\n"
+               "property float z\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n", 4 * n);
+    float rec[6] = {0, 0, 0, 0, 0, 1};
+    for (size_t i = 0; i < 4 * n; ++i) {
+        rec[0] = (float)i, rec[1] = (float)(i % 7);
+        fwrite(rec, sizeof rec, 1, f);
+    }
+    fclose(f);
+    const char *files[] = {xyz, ply};
+    for (int k = 0; k < 2; ++k) {
+        read_watch w = {0};
+        gmpu_points *p = NULL;
+        assert_int_equal(gmpu_points_read_with(files[k], 0, on_read_progress, &w, &p), GMPU_OK);
+        assert_int_equal(gmpu_points_count(p), k ? 4 * n : n);
+        gmpu_points_destroy(p);
+        assert_false(w.wrong_stage || w.decreasing);
+        assert_true(w.last_fraction == 1.0 && (w.reports >= 3 || !timing));
+        if (timing && w.max_gap > 0.05) fail_msg("%s: %.3f s of CPU between two reports", files[k], w.max_gap);
+        const double cancel_at[] = {0.1, 0.6};
+        for (int c = 0; c < 2; ++c) {
+            read_watch wc = {0};
+            wc.cancel_at = cancel_at[c];
+            p = (gmpu_points *)&p;
+            check_failure(gmpu_points_read_with(files[k], 0, on_read_progress, &wc, &p), GMPU_ERROR_CANCELLED,
+                          "reading cancelled");
+            const double latency = thread_cpu() - wc.cancelled_cpu;
+            assert_null(p);
+            assert_true(wc.cancelled_cpu > 0);
+            if (timing && latency > 0.1) fail_msg("%s: back %.3f s of CPU after the cancel", files[k], latency);
+        }
+    }
+    remove(xyz);
+    remove(ply);
+}
+
 static void test_points_write_errors(void **state) {
     (void)state;
     gmpu_points *p = NULL;
@@ -294,6 +424,8 @@ int main(void) {
         cmocka_unit_test(test_points_write_errors), /* first to touch scratch_dir: counts entries */
         cmocka_unit_test(test_points_file_round_trip),
         cmocka_unit_test(test_points_read_errors),
+        cmocka_unit_test(test_points_read_budget),
+        cmocka_unit_test(test_points_read_progress_and_cancel),
         cmocka_unit_test(test_mesh_create_and_access),
         cmocka_unit_test(test_mesh_create_errors),
         cmocka_unit_test(test_mesh_write),

@@ -348,6 +348,34 @@ static void test_max_memory(void **state) {
     gmpu_surface_destroy(s);
 }
 
+/* Orient checks the budget before it starts, like fit and polygonize: a budget the fit
+ * passed but orient's leaf graph, fronts, moments and measures would exceed fails with
+ * LIMIT_EXCEEDED naming orient, and leaves the fit usable. */
+static void test_orient_memory(void **state) {
+    (void)state;
+    gmpu_surface *s = surface_with_points();
+    double ample = 0;
+    assert_ok(gmpu_surface_get_param(s, GMPU_PARAM_MAX_MEMORY, &ample));
+    int window = 0;
+    for (double budget = 1e6; budget <= 1e9 && !window; budget *= 1.1) {
+        assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_MAX_MEMORY, floor(budget)));
+        if (gmpu_surface_fit(s) != GMPU_OK) continue;
+        const gmpu_status status = gmpu_surface_orient(s);
+        if (status == GMPU_OK) break;
+        check_failure2(status, GMPU_ERROR_LIMIT_EXCEEDED, "orient (", "GMPU_PARAM_MAX_MEMORY");
+        window = 1;
+    }
+    if (!window) fail_msg("no budget passed fit but not orient");
+    /* The fit stands: orient with room to spare needs no new fit. */
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_MAX_MEMORY, ample));
+    assert_ok(gmpu_surface_orient(s));
+    gmpu_mesh *m = NULL;
+    assert_ok(gmpu_surface_polygonize(s, &m));
+    assert_null(robust_mesh_problem(m));
+    gmpu_mesh_destroy(m);
+    gmpu_surface_destroy(s);
+}
+
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_max_cells),
@@ -356,6 +384,7 @@ int main(void) {
         cmocka_unit_test(test_memory_returned),
         cmocka_unit_test(test_thread_creation_refused),
         cmocka_unit_test(test_max_memory),
+        cmocka_unit_test(test_orient_memory),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

@@ -7,7 +7,10 @@
 #include <cmath>
 #include <map>
 #include <random>
+#include <cstdlib>
 #include <cstring>
+#include <filesystem>
+#include <string>
 #include <stdexcept>
 #include <vector>
 
@@ -19,6 +22,8 @@
 #include "fit/build_octree.hpp"
 #include "fit/fits.hpp"
 #include "fit/noise_estimate.hpp"
+#include "geometry/clusters.hpp"
+#include "io/io.hpp"
 #include "geometry/outliers.hpp"
 #include "geometry/point_set.hpp"
 #include "implicit/mpu_function.hpp"
@@ -226,6 +231,72 @@ void outliers_are_far_from_everything(void **) {
     assert_true(find_outliers(xyz.data(), 2000, 0).spacing == 0.0);
     std::vector<double> few = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 1e6, 1e6, 1e6};
     assert_true(find_outliers(few.data(), 5, 0).outliers.empty());
+}
+
+// Clusters: groups whose boxes are farther apart than their own sizes; one object (whole,
+// nested, or beside a clump too small to stand alone) stays one cluster.
+void clusters_are_groups_far_apart(void **) {
+    auto shifted = [](PointList pts, Vector3d by) {
+        for (auto &p : pts) p += by;
+        return flat(pts);
+    };
+    const std::vector<uint32_t> none;
+    std::vector<double> big = shifted(sphere_points(3000, 1000, 0, 1), Vector3d::Zero());
+    assert_int_equal(find_clusters(big.data(), 3000, 0, none, 15).count, 1);
+    // A small sphere a thousand of its radii away: two clusters, labelled by input order.
+    std::vector<double> both = shifted(sphere_points(500, 1, 0, 2), Vector3d(1e6, 5, -3));
+    both.insert(both.begin(), big.begin(), big.end());
+    Clusters two = find_clusters(both.data(), 3500, 0, none, 15);
+    assert_int_equal(two.count, 2);
+    for (size_t i = 0; i < 3500; ++i) assert_int_equal(two.labels[i], i < 3000 ? 0 : 1);
+    assert_true(std::fabs(two.boxes[1][0] - (1e6 - 1)) < 0.01 && std::fabs(two.boxes[0][3] - 1000) < 1);
+    std::vector<float> f(both.begin(), both.end());
+    assert_int_equal(find_clusters(f.data(), 3500, 0, none, 15).count, 2);
+    // The same far sphere as outliers (set aside): one cluster; one far outlier among
+    // two clusters is labelled with the nearer.
+    std::vector<uint32_t> tail(500);
+    for (uint32_t k = 0; k < 500; ++k) tail[k] = 3000 + k;
+    assert_int_equal(find_clusters(both.data(), 3500, 0, tail, 15).count, 1);
+    std::vector<double> stray = both;
+    stray.insert(stray.end(), {2e6, 0, 0});
+    Clusters three = find_clusters(stray.data(), 3501, 0, std::vector<uint32_t>{3500}, 15);
+    assert_int_equal(three.count, 2);
+    assert_int_equal(three.labels[3500], 1);
+    // A stray the outlier scan left (the box is not wider than the bulk: half the points are at
+    // each end) does not join the clusters: it goes to the nearer, whose box it does not widen.
+    Clusters strayed = find_clusters(stray.data(), 3501, 0, none, 15);
+    assert_int_equal(strayed.count, 2);
+    assert_int_equal(strayed.labels[3500], 1);
+    assert_true(strayed.boxes[1][3] < 1e6 + 2);
+    stray[3 * 3500] = 5e5;  // halfway: still no bridge
+    assert_int_equal(find_clusters(stray.data(), 3501, 0, none, 15).count, 2);
+    // Nearer than their size, nested, or too few points to stand alone: one cluster.
+    std::vector<double> near = shifted(sphere_points(500, 1000, 0, 2), Vector3d(2900, 0, 0));
+    near.insert(near.begin(), big.begin(), big.end());
+    assert_int_equal(find_clusters(near.data(), 3500, 0, none, 15).count, 1);
+    std::vector<double> nested = shifted(sphere_points(500, 300, 0, 2), Vector3d::Zero());
+    nested.insert(nested.begin(), big.begin(), big.end());
+    assert_int_equal(find_clusters(nested.data(), 3500, 0, none, 15).count, 1);
+    std::vector<double> clump = shifted(sphere_points(40, 1, 0, 2), Vector3d(1e6, 0, 0));
+    clump.insert(clump.begin(), big.begin(), big.end());
+    assert_int_equal(find_clusters(clump.data(), 3040, 0, none, 15).count, 1);
+    // A cluster needs min_points too.
+    assert_int_equal(find_clusters(both.data(), 3500, 0, none, 600).count, 1);
+    // Every cloud of tests/data is one object: one cluster, so its reconstruction takes the
+    // single-surface path, unchanged.
+    const char *root = std::getenv("GMPU_TEST_DATA");
+    assert_non_null(root);
+    size_t clouds = 0;
+    for (const auto &entry : std::filesystem::directory_iterator(std::string(root) + "/clouds")) {
+        const std::string path = entry.path().string();
+        if (entry.path().extension() != ".ply" || path.find("_gt.ply") != std::string::npos) continue;
+        const gmpu::io::PointCloud cloud = gmpu::io::read_points(path);
+        const OutlierScan scan = find_outliers(cloud.positions.data(), cloud.size(), 0);
+        if (find_clusters(cloud.positions.data(), cloud.size(), 0, scan.outliers, 15).count != 1)
+            fail_msg("%s: more than one cluster", path.c_str());
+        ++clouds;
+    }
+    assert_true(clouds >= 10);
 }
 
 void point_set_validation(void **) {
@@ -554,6 +625,7 @@ int main(void) {
         cmocka_unit_test(noise_estimate_ignores_sparse_detail),
         cmocka_unit_test(point_set_validation),
         cmocka_unit_test(outliers_are_far_from_everything),
+        cmocka_unit_test(clusters_are_groups_far_apart),
         cmocka_unit_test(point_set_normalises_and_searches),
         cmocka_unit_test(blend_finds_every_covering_leaf),
         cmocka_unit_test(winding_number_of_a_sampled_sphere),

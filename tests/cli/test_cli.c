@@ -22,6 +22,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -364,6 +365,26 @@ static void test_list_property_in_vertex_element(void **state) {
     remove(out);
 }
 
+/* Outliers are reported on stderr; set aside by default, fitted with --keep-outliers. */
+static void test_outliers_reported_kept_or_set_aside(void **state) {
+    (void)state;
+    double *p = malloc(3 * (N_SPHERE + 2) * sizeof *p);
+    memcpy(p, g_sphere, 3 * N_SPHERE * sizeof *p);
+    const double strays[6] = {3, 0.5, 0, -2, -3, 1};
+    memcpy(p + 3 * N_SPHERE, strays, sizeof strays);
+    const char *in = scratch_path("strays.xyz"), *out = scratch_path("strays.off");
+    put_xyz(in, p, N_SPHERE + 2);
+    const char *set_aside[] = {in, "-o", out, "--resolution", "24", NULL};
+    run_result r = run_cli(set_aside);
+    check_run(&r, 0, "gmpu: 2 outlier points (far from all others) set aside");
+    check_off_sphere(out, (const double[3]){0, 0, 0}, 1.0, 0.05);
+    const char *kept[] = {in, "-o", out, "--keep-outliers", "--resolution", "24", NULL};
+    r = run_cli(kept);
+    check_run(&r, 0, "gmpu: 2 outlier points (far from all others) kept (--keep-outliers)");
+    remove(out);
+    free(p);
+}
+
 /* 1e30 and 1e-30: the mesh is the sphere at that scale. */
 static void test_extreme_scales(void **state) {
     (void)state;
@@ -631,6 +652,8 @@ static void test_option_syntax(void **state) {
     const char *a5[] = {in, "-o", out, "--max-memory=1e6", "--quiet", NULL};
     r = run_cli(a5);
     check_run(&r, 1, "GMPU_PARAM_MAX_MEMORY");
+    check_run(&r, 1, "cannot read input"); /* the reader has the budget too */
+    check_run(&r, 1, "reading it needs about");
     assert_false(exists(out));
     const char *a6[] = {in, "-o", out, "--noise-scale", "-1", "--quiet", NULL};
     r = run_cli(a6);
@@ -689,6 +712,40 @@ static void test_symlink_and_long_names(void **state) {
     remove(long_out);
     remove(scratch_path("keep-p.xyz"));
     assert_no_staging_left();
+}
+
+/* A write that fails midway (here the file-size limit, EFBIG) is reported with the path the
+ * user gave, not the name of the staging file (or of the library's temporary beside it) that
+ * the user never saw; nothing is left behind, and the older output is untouched. */
+static void test_write_failure_names_the_output(void **state) {
+    (void)state;
+    const char *in = scratch_path("keep-sphere.xyz");
+    put_xyz(in, g_sphere, N_SPHERE);
+    const char *outs[] = {"limited.ply", "limited-small.ply"};
+    for (int k = 0; k < 2; ++k) {
+        char out[PATH_MAX], points[PATH_MAX];
+        snprintf(out, sizeof out, "%s", scratch_path(outs[k]));
+        snprintf(points, sizeof points, "%s", scratch_path("limited-points.ply"));
+        put_text(out, "older");
+        /* k = 0: the mesh's write fails; k = 1: the mesh fits, the oriented points do not. */
+        const char *args[] = {in, "-o", out, "--normals-out", points, "--quiet", "--resolution", k ? "8" : "40", NULL};
+        struct rlimit old, small;
+        assert_int_equal(getrlimit(RLIMIT_FSIZE, &old), 0);
+        small = old;
+        small.rlim_cur = k ? 100000 : 20000; /* bytes: mesh at 8 about 55 kB, points about 150 kB */
+        void (*was)(int) = signal(SIGXFSZ, SIG_IGN); /* write() fails with EFBIG instead */
+        assert_int_equal(setrlimit(RLIMIT_FSIZE, &small), 0);
+        run_result r = run_cli(args);
+        assert_int_equal(setrlimit(RLIMIT_FSIZE, &old), 0);
+        signal(SIGXFSZ, was);
+        check_run(&r, 1, "File too large");
+        check_run(&r, 1, k ? points : out);
+        if (strstr(r.err, ".gmpu-") || strstr(r.err, "tmp-gmpu")) fail_msg("message names a staging file: %s", r.err);
+        assert_file_is(out, "older");
+        assert_false(exists(points));
+        assert_no_staging_left();
+        remove(out);
+    }
 }
 
 /* Runs a reconstruction and sends `sig` the moment a staging file appears; 1 if the signal
@@ -780,12 +837,14 @@ int main(void) {
         cmocka_unit_test(test_truncated_and_lying_files),
         cmocka_unit_test(test_list_property_in_vertex_element),
         cmocka_unit_test(test_extreme_scales),
+        cmocka_unit_test(test_outliers_reported_kept_or_set_aside),
         cmocka_unit_test(test_outputs),
         cmocka_unit_test(test_bad_usage),
         cmocka_unit_test(test_input_never_lost),
         cmocka_unit_test(test_older_output_and_same_file),
         cmocka_unit_test(test_option_syntax),
         cmocka_unit_test(test_symlink_and_long_names),
+        cmocka_unit_test(test_write_failure_names_the_output),
         cmocka_unit_test(test_sigterm_during_write_leaves_nothing),
         cmocka_unit_test(test_leftovers_of_a_killed_run_are_ignored),
     };

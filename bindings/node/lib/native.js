@@ -120,6 +120,8 @@ function declare(lib) {
         mesh_write: f('int', 'gmpu_mesh_write', ['void *', 'const char *']),
 
         points_read: f('int', 'gmpu_points_read', ['const char *', outPtr]),
+        points_read_with: f('int', 'gmpu_points_read_with',
+            ['const char *', 'double', koffi.pointer(progressProto), 'void *', outPtr]),
         points_create: f('int', 'gmpu_points_create', ['double *', 'double *', 'size_t', outPtr]),
         points_destroy: f('void', 'gmpu_points_destroy', ['void *']),
         points_count: f('size_t', 'gmpu_points_count', ['void *']),

@@ -297,6 +297,8 @@ key_enum! {
         /// Memory budget in bytes: fit and polygonize fail with [`Status::LimitExceeded`]
         /// when their estimated peak exceeds it.
         MaxMemory = sys::GMPU_PARAM_MAX_MEMORY,
+        /// 1 (default): set_points leaves the outliers it finds out of the fit; 0 fits them.
+        RemoveOutliers = sys::GMPU_PARAM_REMOVE_OUTLIERS,
     }
 }
 
@@ -432,6 +434,8 @@ pub enum Stage {
     Orient,
     /// [`Surface::polygonize`].
     Polygonize,
+    /// `gmpu_points_read_with` (not wrapped by this binding yet).
+    Read,
     /// A stage this binding does not know (from a newer library).
     Unknown(u32),
 }
@@ -443,6 +447,7 @@ impl Stage {
             sys::GMPU_STAGE_FIT => Stage::Fit,
             sys::GMPU_STAGE_ORIENT => Stage::Orient,
             sys::GMPU_STAGE_POLYGONIZE => Stage::Polygonize,
+            sys::GMPU_STAGE_READ => Stage::Read,
             other => Stage::Unknown(other),
         }
     }
@@ -453,6 +458,7 @@ impl Stage {
             Stage::Fit => sys::GMPU_STAGE_FIT,
             Stage::Orient => sys::GMPU_STAGE_ORIENT,
             Stage::Polygonize => sys::GMPU_STAGE_POLYGONIZE,
+            Stage::Read => sys::GMPU_STAGE_READ,
             Stage::Unknown(raw) => raw,
         }
     }

@@ -135,6 +135,7 @@ c_enums! {
         GMPU_PARAM_MAX_TRIANGLES = 10,
         GMPU_PARAM_NOISE_SCALE = 11,
         GMPU_PARAM_MAX_MEMORY = 12,
+        GMPU_PARAM_REMOVE_OUTLIERS = 13,
     }
     gmpu_value_type {
         GMPU_TYPE_INT = 1,
@@ -144,6 +145,7 @@ c_enums! {
         GMPU_STAGE_FIT = 1,
         GMPU_STAGE_ORIENT = 2,
         GMPU_STAGE_POLYGONIZE = 3,
+        GMPU_STAGE_READ = 4,
     }
     gmpu_stat {
         GMPU_STAT_POINTS = 1,
@@ -238,6 +240,13 @@ c_functions! {
     pub fn gmpu_mesh_write(mesh: *const gmpu_mesh, path: *const c_char) -> gmpu_status;
 
     pub fn gmpu_points_read(path: *const c_char, out: *mut *mut gmpu_points) -> gmpu_status;
+    pub fn gmpu_points_read_with(
+        path: *const c_char,
+        max_memory: f64,
+        fn_: gmpu_progress_fn,
+        user: *mut c_void,
+        out: *mut *mut gmpu_points,
+    ) -> gmpu_status;
     pub fn gmpu_points_create(xyz: *const f64, normals: *const f64, count: usize, out: *mut *mut gmpu_points)
         -> gmpu_status;
     pub fn gmpu_points_destroy(points: *mut gmpu_points);
