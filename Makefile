@@ -10,7 +10,7 @@ SAMPLE := examples/data/bunny.ply
 DEMO_OUT := $(BUILD)/demo/bunny_mesh.ply
 
 # Debian packages each target needs; `deps-*` installs only the missing ones.
-CORE_PKGS := g++ pkg-config meson ninja-build libeigen3-dev libnanoflann-dev libcmocka-dev
+CORE_PKGS := g++ pkg-config meson ninja-build libeigen3-dev libnanoflann-dev libcmocka-dev libmeshoptimizer-dev
 TEST_PKGS := $(CORE_PKGS) python3-cffi python3-numpy python3-pytest python3-matplotlib \
              valgrind clang libclang-rt-14-dev time
 BENCH_PKGS := $(TEST_PKGS) python3-open3d libcgal-dev libgmp-dev libmpfr-dev time

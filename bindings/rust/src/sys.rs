@@ -72,9 +72,9 @@ macro_rules! c_functions {
 
 /// `#define`d integer constants of the header.
 pub const GMPU_VERSION_MAJOR: u32 = 0;
-pub const GMPU_VERSION_MINOR: u32 = 2;
+pub const GMPU_VERSION_MINOR: u32 = 3;
 pub const GMPU_VERSION_PATCH: u32 = 0;
-pub const GMPU_VERSION_NUMBER: u32 = 200;
+pub const GMPU_VERSION_NUMBER: u32 = 300;
 pub const GMPU_ABI_VERSION: u32 = 1;
 pub const DEFINES: &[(&str, u32)] = &[
     ("GMPU_VERSION_MAJOR", GMPU_VERSION_MAJOR),
@@ -211,6 +211,10 @@ c_functions! {
     pub fn gmpu_mesh_normals(mesh: *const gmpu_mesh) -> *const f64;
     pub fn gmpu_mesh_triangles(mesh: *const gmpu_mesh) -> *const u32;
     pub fn gmpu_mesh_write(mesh: *const gmpu_mesh, path: *const c_char) -> gmpu_status;
+    pub fn gmpu_mesh_confidence(mesh: *const gmpu_mesh) -> *const f64;
+    pub fn gmpu_mesh_simplify(mesh: *const gmpu_mesh, target_triangles: usize, target_error: f64,
+                              out: *mut *mut gmpu_mesh) -> gmpu_status;
+    pub fn gmpu_mesh_trim(mesh: *const gmpu_mesh, threshold: f64, out: *mut *mut gmpu_mesh) -> gmpu_status;
 
     pub fn gmpu_points_read(path: *const c_char, out: *mut *mut gmpu_points) -> gmpu_status;
     pub fn gmpu_points_create(xyz: *const f64, normals: *const f64, count: usize, out: *mut *mut gmpu_points)
