@@ -151,6 +151,13 @@ bench: deps-bench build
 	$(PYTHON) tests/bench/run_bench.py --build $(BUILD) --out bench-results
 	$(PYTHON) tests/bench/run_bench.py --corpus-only --corpus-peers $(CORPUS_PEERS) --build $(BUILD) --out bench-results
 	$(PYTHON) tests/bench/update_readme.py bench-results
+	$(MAKE) --no-print-directory bench-meshes
+
+# Decimation, level-of-detail topology and trimmed open scans (tests/bench/mesh_ops.py;
+# the trim rows need the corpus clouds the corpus section generates).
+.PHONY: bench-meshes
+bench-meshes: deps-bench build
+	$(PYTHON) tests/bench/mesh_ops.py --build $(BUILD) --out bench-results/mesh_ops
 
 # The corpus section alone (issue 13's targets on 106 generated clouds).
 bench-corpus: deps-bench build

@@ -131,7 +131,9 @@ typedef enum gmpu_param {
      * least 8. Default 0, range 0..4096. */
     GMPU_PARAM_RESOLUTION = 6,
     /* Level of detail: evaluate and polygonize using octree cells down to this level
-     * only (paper Fig. 7); 0 uses every level. Default 0, range 0..16. */
+     * only (paper Fig. 7), and deeper only where a cell of this level fits its points worse
+     * than 7 % of its size (so the coarse surface keeps the topology of the full one);
+     * 0 uses every level. Default 0, range 0..16. */
     GMPU_PARAM_LEVEL = 7,
     /* Worker threads for fit, orient and polygonize; 0 uses every core. Default 0,
      * range 0..1024. */

@@ -119,6 +119,10 @@ def open3d_trimmed_poisson(cloud, out, depth=8, quantile=0.05):
 
 def trim(args, tmp):
     rows = []
+    missing = [n for n in OPEN_SCANS if not (args.corpus / f"{n}.ply").exists()]
+    if missing:
+        print(f"trim: skipped, {', '.join(missing)} not in {args.corpus} (make bench-corpus generates them)")
+        return rows
     for name in OPEN_SCANS:
         cloud = args.corpus / f"{name}.ply"
         gt = gt_mesh_of(cloud)
@@ -151,9 +155,9 @@ def main():
     ap.add_argument("--build", type=Path, default=ROOT / "build")
     ap.add_argument("--out", type=Path, default=ROOT / "bench-results" / "mesh_ops")
     ap.add_argument("--sections", default="decimation,lod,trim")
-    ap.add_argument("--corpus", type=Path, default=Path("/work/corpus"),
+    ap.add_argument("--corpus", type=Path, default=ROOT / "bench-results" / "corpus" / "clouds",
                     help="directory of the generated corpus clouds (tests/data/corpus/make.sh)")
-    ap.add_argument("--trim-values", type=lambda s: [float(x) for x in s.split(",") if x], default=[])
+    ap.add_argument("--trim-values", type=lambda s: [float(x) for x in s.split(",") if x], default=[2.0, 1.5])
     ap.add_argument("--no-open3d", dest="open3d", action="store_false")
     args = ap.parse_args()
     args.cli = args.build / "examples" / "gmpu-reconstruct"

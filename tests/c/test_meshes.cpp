@@ -213,6 +213,36 @@ void confidence_in_ply(void **) {
     gmpu_mesh_destroy(m);
 }
 
+// bunny_clean (35k points) at level caps 5 and 6 has the full surface's components and
+// genus: capped cells whose fit does not have the shape of their points are not used.
+void level_of_detail_keeps_the_topology_of_the_full_surface(void **) {
+    const OrientedPoints cloud = load_points(test_data("clouds/bunny_clean.ply"));
+    gmpu_surface *s = nullptr;
+    assert_int_equal(gmpu_surface_create(&s), GMPU_OK);
+    assert_int_equal(gmpu_surface_set_points_f64(s, cloud.positions[0].data(), cloud.positions.size(), sizeof(Vec3)),
+                     GMPU_OK);
+    assert_int_equal(gmpu_surface_fit(s), GMPU_OK);
+    assert_int_equal(gmpu_surface_orient(s), GMPU_OK);
+    MeshCheck full;
+    for (int level : {0, 5, 6}) {
+        assert_int_equal(gmpu_surface_set_param(s, GMPU_PARAM_LEVEL, level), GMPU_OK);
+        gmpu_mesh *m = nullptr;
+        assert_int_equal(gmpu_surface_polygonize(s, &m), GMPU_OK);
+        const MeshCheck c = check_mesh(arrays(m));
+        gmpu_mesh_destroy(m);
+        fprintf(stderr, "  level %d: %zu components, genus of the largest %d\n", level, c.components,
+                c.component_reports.empty() ? -1 : c.component_reports[0].genus);
+        assert_true(c.watertight);
+        if (level == 0) {
+            full = c;
+            continue;
+        }
+        assert_int_equal(c.components, full.components);
+        assert_true(genera(c) == genera(full));
+    }
+    gmpu_surface_destroy(s);
+}
+
 }  // namespace
 
 int main(void) {
@@ -223,6 +253,7 @@ int main(void) {
         cmocka_unit_test(simplify_bad_arguments),
         cmocka_unit_test(trim_opens_the_hole),
         cmocka_unit_test(confidence_in_ply),
+        cmocka_unit_test(level_of_detail_keeps_the_topology_of_the_full_surface),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
