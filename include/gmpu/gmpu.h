@@ -345,7 +345,8 @@ GMPU_API const double *gmpu_mesh_confidence(const gmpu_mesh *mesh);
  * same components and genus, and borders stay where they are; when that stops further
  * collapses, the result has more triangles than target_triangles. Vertices are a subset
  * of the input's (confidence carried); normals are recomputed from the triangles (area-
- * weighted). Errors: INVALID_ARGUMENT (NULL, target_error outside [0, 1] or NaN),
+ * weighted); the vertices no triangle uses are dropped (a mesh without triangles gives an
+ * empty mesh). Errors: INVALID_ARGUMENT (NULL, target_error outside [0, 1] or NaN),
  * OUT_OF_MEMORY. Cost: O(n log n). */
 GMPU_API gmpu_status gmpu_mesh_simplify(const gmpu_mesh *mesh, size_t target_triangles, double target_error,
                                         gmpu_mesh **out);

@@ -127,6 +127,8 @@ size_t collapse_round(const std::vector<uint32_t> &triangles, const std::vector<
 }  // namespace
 
 Mesh simplify_mesh(const Mesh &mesh, size_t target_triangles, double target_error, double *achieved_error) {
+    if (achieved_error) *achieved_error = 0.0;
+    if (mesh.triangles.empty()) return Mesh();  // nothing to weld or collapse (and no vertex in use)
     Mesh base = welded(mesh);
     const MeshTopology before = mesh_topology(base);
     std::vector<float> positions(base.vertices.begin(), base.vertices.end());

@@ -15,7 +15,8 @@ namespace gmpu {
 // changes the topology is retried with a smaller reduction, and simplification stops at
 // the last mesh that kept it. Vertices are a subset of the input's (positions exact, the
 // confidence carried); normals are recomputed from the triangles. `achieved_error` (may be
-// null) receives the accumulated error bound, as a fraction of the diagonal.
+// null) receives the accumulated error bound, as a fraction of the diagonal. A mesh without
+// triangles gives an empty mesh.
 Mesh simplify_mesh(const Mesh &mesh, size_t target_triangles, double target_error, double *achieved_error);
 
 // Unit area-weighted vertex normals of the triangles (a vertex no triangle uses keeps

@@ -138,6 +138,14 @@ void simplify_bad_arguments(void **) {
     assert_null(gmpu_mesh_confidence(out));
     gmpu_mesh_destroy(out);
     out = nullptr;
+    // Vertices without triangles: nothing to simplify, an empty mesh.
+    gmpu_mesh *points_only = nullptr;
+    assert_int_equal(gmpu_mesh_create(v, 4, nullptr, 0, &points_only), GMPU_OK);
+    assert_int_equal(gmpu_mesh_simplify(points_only, 0, 0.0, &out), GMPU_OK);
+    assert_int_equal(gmpu_mesh_triangle_count(out), 0);
+    gmpu_mesh_destroy(out);
+    gmpu_mesh_destroy(points_only);
+    out = nullptr;
     assert_int_equal(gmpu_mesh_trim(m, 3.0, &out), GMPU_ERROR_INVALID_ARGUMENT);
     assert_non_null(strstr(gmpu_last_error(), "confidence"));
     assert_null(out);
