@@ -1,6 +1,8 @@
 """Mesh operations through the Python binding: decimation keeps a closed, manifold mesh of
 the same topology within its triangle target; confidence marks unsupported surface and
-trim opens the caps over a scan's holes."""
+trim opens the caps over a scan's holes; the CLI's --trim and --target-triangles."""
+import subprocess
+
 import numpy as np
 import pytest
 
@@ -68,3 +70,25 @@ def test_trim_opens_the_hole_of_a_capped_sphere():
     assert chi == 1  # a disc: one boundary loop
     assert trimmed.vertices[:, 2].max() < 0.85
     assert np.all(np.abs(np.linalg.norm(trimmed.vertices, axis=1) - 1) < 0.1)
+
+
+def test_cli_trims_and_decimates(cli, tmp_path):
+    pts = sphere(6000, 4, keep=lambda p: p[:, 2] < 0.6)
+    cloud = tmp_path / "capped.xyz"
+    np.savetxt(cloud, pts)
+    full, small = tmp_path / "full.ply", tmp_path / "small.ply"
+    subprocess.run([str(cli), str(cloud), "-o", str(full), "--quiet"], check=True)
+    subprocess.run([str(cli), str(cloud), "-o", str(small), "--quiet", "--trim", "--target-triangles", "2000"],
+                   check=True)
+    header = small.read_bytes().split(b"end_header")[0].decode()
+    assert "property float confidence" in header
+    faces = int(header.split("element face ")[1].split()[0])
+    assert 0 < faces <= 2000
+    full_faces = int(full.read_bytes().split(b"element face ")[1].split()[0])
+    assert full_faces > 10 * faces
+    bad = subprocess.run([str(cli), str(cloud), "-o", str(small), "--target-triangles", "0"], capture_output=True,
+                         text=True)
+    assert bad.returncode == 2 and "--target-triangles" in bad.stderr
+    bad = subprocess.run([str(cli), str(cloud), "-o", str(small), "--target-error", "2"], capture_output=True,
+                         text=True)
+    assert bad.returncode == 1 and "target_error" in bad.stderr
