@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include <Eigen/Core>
@@ -111,7 +112,7 @@ size_t collapse_round(const std::vector<uint32_t> &triangles, const std::vector<
         done[v] = 1;
         original.push_back(v);
         const float x = pos[3 * v];
-        pos.insert(pos.end(), {std::nextafter(x, INFINITY), pos[3 * v + 1], pos[3 * v + 2]});
+        pos.insert(pos.end(), {std::nextafter(x, std::numeric_limits<float>::infinity()), pos[3 * v + 1], pos[3 * v + 2]});
         v = uint32_t(n + original.size() - 1);
     }
     out.resize(in.size());
