@@ -10,7 +10,7 @@ SAMPLE := examples/data/bunny.ply
 DEMO_OUT := $(BUILD)/demo/bunny_mesh.ply
 
 # Debian packages each target needs; `deps-*` installs only the missing ones.
-CORE_PKGS := g++ pkg-config meson ninja-build libeigen3-dev libnanoflann-dev libcmocka-dev
+CORE_PKGS := g++ pkg-config meson ninja-build libeigen3-dev libnanoflann-dev libcmocka-dev libmeshoptimizer-dev
 TEST_PKGS := $(CORE_PKGS) python3-cffi python3-numpy python3-pytest python3-matplotlib \
              valgrind clang libclang-rt-14-dev time
 BENCH_PKGS := $(TEST_PKGS) python3-open3d libcgal-dev libgmp-dev libmpfr-dev time
@@ -194,6 +194,13 @@ bench: deps-bench build
 	$(PYTHON) tests/bench/run_bench.py --build $(BUILD) --out bench-results
 	$(PYTHON) tests/bench/run_bench.py --corpus-only --corpus-peers $(CORPUS_PEERS) --build $(BUILD) --out bench-results
 	$(PYTHON) tests/bench/update_readme.py bench-results
+	$(MAKE) --no-print-directory bench-meshes
+
+# Decimation, level-of-detail topology and trimmed open scans (tests/bench/mesh_ops.py;
+# the trim rows need the corpus clouds the corpus section generates).
+.PHONY: bench-meshes
+bench-meshes: deps-bench build
+	$(PYTHON) tests/bench/mesh_ops.py --build $(BUILD) --out bench-results/mesh_ops
 
 # The corpus section alone (issue 13's targets on 106 generated clouds).
 bench-corpus: deps-bench build

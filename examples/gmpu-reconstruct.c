@@ -6,6 +6,7 @@
  *                    [--max-depth D] [--resolution R] [--level L] [--threads T]
  *                    [--noise-scale S] [--max-memory BYTES] [--param NAME=VALUE]...
  *                    [--use-normals] [--sharp] [--quiet] [--version]
+ *                    [--trim[=T]] [--target-triangles N] [--target-error E]
  *
  * --param sets any parameter of the library's table by name (gmpu_param_key); --help lists
  * them all with their defaults and ranges (gmpu_param_info).
@@ -32,6 +33,7 @@
 typedef struct {
     const char *input, *output, *normals_out;
     double error, max_depth, resolution, level, threads, noise_scale, max_memory;
+    double trim, target_triangles, target_error; /* NAN: not asked for */
     int use_normals, sharp, quiet, keep_outliers;
     int param_count; /* --param NAME=VALUE, applied after the flags above, in order */
     gmpu_param param_keys[MAX_PARAMS];
@@ -45,10 +47,15 @@ static const char *usage =
     "                        [--max-depth D] [--resolution R] [--level L] [--threads T]\n"
     "                        [--noise-scale S] [--max-memory BYTES] [--param NAME=VALUE]...\n"
     "                        [--use-normals] [--sharp] [--keep-outliers] [--quiet] [--version]\n"
+    "                        [--trim[=T]] [--target-triangles N] [--target-error E]\n"
     "  INPUT   .ply .xyz .txt .off .obj point cloud (normals ignored unless --use-normals)\n"
-    "  OUTPUT  .ply .obj .off mesh (closed, outward-facing)\n"
+    "  OUTPUT  .ply .obj .off mesh (closed, outward-facing; .ply with a per-vertex confidence)\n"
     "  --keep-outliers fits the outliers found (points far from all others) too; by default\n"
     "  they are reported and set aside.\n"
+    "  --trim[=T]  remove surface farther than T sample spacings from every point (default 3):\n"
+    "              the caps over a scan's holes go, leaving an open mesh\n"
+    "  --target-triangles N, --target-error E  decimate to at most N triangles, moving the\n"
+    "              surface by at most E x the diagonal (topology kept)\n"
     "  Options take their value as the next argument or after '=' (--resolution=64).\n"
     "  A file name starting with '-' must be written ./-name.\n"
     "  --param NAME=VALUE sets any parameter (--help lists them).\n";
@@ -114,7 +121,11 @@ static int parse_path(const char *flag, const char *text, const char **out) {
 }
 
 enum { OPT_NORMALS_OUT = 256, OPT_ERROR, OPT_MAX_DEPTH, OPT_RESOLUTION, OPT_LEVEL, OPT_THREADS, OPT_USE_NORMALS,
-       OPT_SHARP, OPT_NOISE_SCALE, OPT_MAX_MEMORY, OPT_PARAM, OPT_KEEP_OUTLIERS };
+       OPT_SHARP, OPT_NOISE_SCALE, OPT_MAX_MEMORY, OPT_PARAM, OPT_KEEP_OUTLIERS, OPT_TRIM, OPT_TARGET_TRIANGLES,
+       OPT_TARGET_ERROR };
+
+/* Sample spacings beyond which --trim drops surface: the caps over holes are farther. */
+#define DEFAULT_TRIM 3.0
 
 static const struct option long_options[] = {
     {"output", required_argument, NULL, 'o'},
@@ -130,6 +141,9 @@ static const struct option long_options[] = {
     {"use-normals", no_argument, NULL, OPT_USE_NORMALS},
     {"sharp", no_argument, NULL, OPT_SHARP},
     {"keep-outliers", no_argument, NULL, OPT_KEEP_OUTLIERS},
+    {"trim", optional_argument, NULL, OPT_TRIM},
+    {"target-triangles", required_argument, NULL, OPT_TARGET_TRIANGLES},
+    {"target-error", required_argument, NULL, OPT_TARGET_ERROR},
     {"quiet", no_argument, NULL, 'q'},
     {"help", no_argument, NULL, 'h'},
     {"version", no_argument, NULL, 'V'},
@@ -149,6 +163,7 @@ static int parse_args(int argc, char **argv, options *o) {
     memset(o, 0, sizeof *o);
     /* NAN: not given (a negative value is given, and must reach the library's range check). */
     o->error = o->max_depth = o->resolution = o->level = o->threads = o->noise_scale = o->max_memory = NAN;
+    o->trim = o->target_triangles = o->target_error = NAN;
     opterr = 0; /* our own messages, one line each */
     optind = 1;
     /* "-": non-options come back in order (code 1), whatever POSIXLY_CORRECT says; ":": a
@@ -185,6 +200,20 @@ static int parse_args(int argc, char **argv, options *o) {
             case OPT_NOISE_SCALE: if (!parse_number(flag, optarg, &o->noise_scale)) return 0; break;
             case OPT_MAX_MEMORY: if (!parse_number(flag, optarg, &o->max_memory)) return 0; break;
             case OPT_PARAM: if (!parse_param(optarg, o)) return 0; break;
+            case OPT_TRIM:
+                o->trim = DEFAULT_TRIM;
+                if (optarg && !parse_number(flag, optarg, &o->trim)) return 0;
+                break;
+            case OPT_TARGET_TRIANGLES:
+                if (!parse_number(flag, optarg, &o->target_triangles)) return 0;
+                if (o->target_triangles < 1 || o->target_triangles != floor(o->target_triangles) ||
+                    o->target_triangles > 4e9) {
+                    fprintf(stderr, "gmpu-reconstruct: %s needs a whole number of triangles >= 1, got '%s'\n", flag,
+                            optarg);
+                    return 0;
+                }
+                break;
+            case OPT_TARGET_ERROR: if (!parse_number(flag, optarg, &o->target_error)) return 0; break;
             case OPT_USE_NORMALS: o->use_normals = 1; break;
             case OPT_SHARP: o->sharp = 1; break;
             case OPT_KEEP_OUTLIERS: o->keep_outliers = 1; break;
@@ -342,6 +371,25 @@ static int prepare_outputs(const options *o, staged_output *mesh_out, staged_out
     return 1;
 }
 
+/* Replaces *mesh with its trimmed, then simplified, version when the options ask for it. */
+static int finish_mesh(const options *o, gmpu_mesh **mesh) {
+    gmpu_mesh *next = NULL;
+    if (!isnan(o->trim)) {
+        if (gmpu_mesh_trim(*mesh, o->trim, &next) != GMPU_OK) return !fail("trim failed");
+        gmpu_mesh_destroy(*mesh);
+        *mesh = next;
+    }
+    if (!isnan(o->target_triangles) || !isnan(o->target_error)) {
+        /* One limit alone: the other does not bound. */
+        const size_t triangles = isnan(o->target_triangles) ? 0 : (size_t)o->target_triangles;
+        const double error = isnan(o->target_error) ? 1.0 : o->target_error;
+        if (gmpu_mesh_simplify(*mesh, triangles, error, &next) != GMPU_OK) return !fail("simplify failed");
+        gmpu_mesh_destroy(*mesh);
+        *mesh = next;
+    }
+    return 1;
+}
+
 int main(int argc, char **argv) {
     options o;
     if (!parse_args(argc, argv, &o)) return 2;
@@ -405,6 +453,7 @@ int main(int argc, char **argv) {
     if (gmpu_surface_fit(surface) != GMPU_OK) { rc = fail("fit failed"); goto done; }
     if (gmpu_surface_orient(surface) != GMPU_OK) { rc = fail("orient failed"); goto done; }
     if (gmpu_surface_polygonize(surface, &mesh) != GMPU_OK) { rc = fail("polygonize failed"); goto done; }
+    if (!finish_mesh(&o, &mesh)) goto done;
     double t_write = now_seconds();
     mesh_vertices = gmpu_mesh_vertex_count(mesh);
     mesh_triangles = gmpu_mesh_triangle_count(mesh);

@@ -173,6 +173,8 @@ export interface Mesh {
     faces: Uint32Array;
     /** Unit outward normal per vertex (null for meshes not made by polygonize). */
     normals: Float64Array | null;
+    /** Per vertex: distance to the nearest input point in sample spacings (null for meshes not made by polygonize). */
+    confidence: Float64Array | null;
 }
 
 /** A point cloud read from a file. */
@@ -267,6 +269,12 @@ export declare function readPoints(path: string | URL): PointCloud;
  * .obj or .off from the extension; atomic. Vertex normals are not written.
  */
 export declare function writeMesh(path: string | URL, mesh: { vertices: Points; faces: Faces }): void;
+
+/** gmpu_mesh_simplify: a decimated copy with at most targetTriangles triangles and error at most targetError × diagonal; topology kept. */
+export declare function simplifyMesh(
+    mesh: { vertices: Points; faces: Faces },
+    options?: { targetTriangles?: number; targetError?: number },
+): Mesh;
 
 /** gmpu_points_create + gmpu_points_write: .ply (binary little-endian) or .xyz; atomic. */
 export declare function writePoints(path: string | URL, cloud: { positions: Points; normals?: Points | null }): void;

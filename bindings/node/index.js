@@ -652,6 +652,7 @@ function takeMesh(ptr) {
             vertices: copyArray(n.mesh_vertices(ptr), 'double', 3 * vertexCount),
             faces: copyArray(n.mesh_triangles(ptr), 'uint32_t', 3 * triangleCount),
             normals: copyArray(n.mesh_normals(ptr), 'double', 3 * vertexCount),
+            confidence: copyArray(n.mesh_confidence(ptr), 'double', vertexCount),
         };
     } finally {
         n.mesh_destroy(ptr);
@@ -732,6 +733,37 @@ export function writeMesh(file, mesh) {
         check(n.mesh_write(out[0], p));
     } finally {
         n.mesh_destroy(out[0]);
+    }
+}
+
+/**
+ * Decimates a mesh { vertices, faces } (gmpu_mesh_simplify): at most
+ * options.targetTriangles triangles (0 or absent: no count target), the surface moved by at
+ * most options.targetError × the bounding-box diagonal (default 1: no bound). Topology is
+ * kept (closed, manifold, components, genus), so it may stop above the count. Returns a new
+ * { vertices, faces, normals, confidence } with recomputed normals (confidence null: meshes
+ * built from arrays carry none).
+ */
+export function simplifyMesh(mesh, options = {}) {
+    if (mesh === null || typeof mesh !== 'object') throw invalidArgument('mesh must be an object { vertices, faces }');
+    if (options === null || typeof options !== 'object') throw invalidArgument('options must be an object');
+    const { targetTriangles = 0, targetError = 1, ...unknown } = options;
+    const extra = Object.keys(unknown);
+    if (extra.length) throw invalidArgument(`unknown option '${extra[0]}' (options: targetTriangles, targetError)`);
+    if (!Number.isSafeInteger(targetTriangles) || targetTriangles < 0)
+        throw invalidArgument(`targetTriangles must be a non-negative integer, got ${describe(targetTriangles)}`);
+    if (typeof targetError !== 'number') throw invalidArgument(`targetError must be a number, got ${describe(targetError)}`);
+    const { data: vertices, count: vertexCount } = toXyz(mesh.vertices, 'mesh.vertices', { allowF32: false });
+    const faces = toFaces(mesh.faces, 'mesh.faces');
+    const n = lib();
+    const made = [null];
+    check(n.mesh_create(vertexCount ? vertices : null, vertexCount, faces.length ? faces : null, faces.length / 3, made));
+    try {
+        const out = [null];
+        check(n.mesh_simplify(made[0], targetTriangles, targetError, out));
+        return takeMesh(out[0]);
+    } finally {
+        n.mesh_destroy(made[0]);
     }
 }
 

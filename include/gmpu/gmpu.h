@@ -12,7 +12,8 @@
  *   - The message of a failure is available from gmpu_last_error() (the calling thread's
  *     last failure, any function) and, for calls that modify a surface, also from
  *     gmpu_surface_last_error(surface).
- *   - Ownership: what gmpu_*_create / gmpu_*_read / gmpu_surface_polygonize hands out,
+ *   - Ownership: what gmpu_*_create / gmpu_*_read / gmpu_surface_polygonize /
+ *     gmpu_mesh_simplify / gmpu_mesh_trim hands out,
  *     the matching gmpu_*_destroy frees. Pointers returned by accessors are owned by the
  *     object they came from and stay valid until it is destroyed. Input arrays are
  *     copied; gmpu never keeps a caller's pointer.
@@ -131,7 +132,9 @@ typedef enum gmpu_param {
      * least 8. Default 0, range 0..4096. */
     GMPU_PARAM_RESOLUTION = 6,
     /* Level of detail: evaluate and polygonize using octree cells down to this level
-     * only (paper Fig. 7); 0 uses every level. Default 0, range 0..16. */
+     * only (paper Fig. 7), and deeper only where a cell of this level fits its points worse
+     * than 7 % of its size (so the coarse surface keeps the topology of the full one);
+     * 0 uses every level. Default 0, range 0..16. */
     GMPU_PARAM_LEVEL = 7,
     /* Worker threads for fit, orient and polygonize; 0 uses every core. Default 0,
      * range 0..1024. */
@@ -374,6 +377,33 @@ GMPU_API const double *gmpu_mesh_vertices(const gmpu_mesh *mesh);
 GMPU_API const double *gmpu_mesh_normals(const gmpu_mesh *mesh);
 /* Three vertex indices per triangle (3 × triangle_count). */
 GMPU_API const uint32_t *gmpu_mesh_triangles(const gmpu_mesh *mesh);
+/* How well the input supports each vertex (vertex_count doubles): the distance to the
+ * nearest input point in units of that point's sample spacing. About 0.5 or less where the
+ * points sample the surface; several where the surface bridges a hole of the scan. NULL
+ * for a mesh made by gmpu_mesh_create. Simplify and trim carry it; .ply files get it as
+ * a float vertex property "confidence". */
+GMPU_API const double *gmpu_mesh_confidence(const gmpu_mesh *mesh);
+
+/* Decimation: a new mesh with fewer triangles, the input untouched. Vertices at identical
+ * positions are first welded; then edges collapse (quadric error, meshoptimizer) until at
+ * most target_triangles remain (0: no count target) or a further collapse would move the
+ * surface by more than target_error × the bounding-box diagonal (1 bounds nothing; 0 still
+ * merges flat areas). Topology is kept: a closed, edge-manifold mesh stays one, with the
+ * same components and genus, and borders stay where they are; when that stops further
+ * collapses, the result has more triangles than target_triangles. Vertices are a subset
+ * of the input's (confidence carried); normals are recomputed from the triangles (area-
+ * weighted); the vertices no triangle uses are dropped (a mesh without triangles gives an
+ * empty mesh). Errors: INVALID_ARGUMENT (NULL, target_error outside [0, 1] or NaN),
+ * OUT_OF_MEMORY. Cost: O(n log n). */
+GMPU_API gmpu_status gmpu_mesh_simplify(const gmpu_mesh *mesh, size_t target_triangles, double target_error,
+                                        gmpu_mesh **out);
+
+/* Trimming an open scan: a new mesh without the triangles that have a vertex whose
+ * confidence is above threshold (in sample spacings; 2 to 4 removes the caps polygonize
+ * closes holes with), so the result has boundaries where the data has holes. Errors:
+ * INVALID_ARGUMENT (NULL, threshold not finite and positive, a mesh without confidence),
+ * OUT_OF_MEMORY. */
+GMPU_API gmpu_status gmpu_mesh_trim(const gmpu_mesh *mesh, double threshold, gmpu_mesh **out);
 
 /* Writes the mesh; the format comes from the extension: .ply (binary little-endian),
  * .obj, .off. The file is written beside the target under a temporary name and renamed,

@@ -1,5 +1,5 @@
 // C ABI of meshes: built from caller arrays (or by gmpu_surface_polygonize), queried,
-// written.
+// simplified, trimmed, written.
 #include <cmath>
 #include <cstdint>
 #include <memory>
@@ -9,6 +9,8 @@
 #include "api/handles.hpp"
 #include "gmpu/gmpu.h"
 #include "io/io.hpp"
+#include "mesh/confidence.hpp"
+#include "mesh/simplify.hpp"
 
 extern "C" {
 
@@ -78,6 +80,50 @@ GMPU_API const uint32_t *gmpu_mesh_triangles(const gmpu_mesh *mesh) {
     return p;
 }
 
+GMPU_API const double *gmpu_mesh_confidence(const gmpu_mesh *mesh) {
+    const double *p = nullptr;
+    gmpu::api::guarded(nullptr, [&] {
+        p = mesh && !mesh->mesh.confidence.empty() ? mesh->mesh.confidence.data() : nullptr;
+    });
+    return p;
+}
+
+GMPU_API gmpu_status gmpu_mesh_simplify(const gmpu_mesh *mesh, size_t target_triangles, double target_error,
+                                        gmpu_mesh **out) {
+    using gmpu::Error;
+    return gmpu::api::guarded(nullptr, [&] {
+        gmpu::api::require_arg(out, "out");
+        *out = nullptr;
+        gmpu::api::require_arg(mesh, "mesh");
+        if (!(target_error >= 0.0 && target_error <= 1.0))
+            throw Error(GMPU_ERROR_INVALID_ARGUMENT,
+                        "target_error must be in [0, 1] (a fraction of the bounding-box diagonal), not " +
+                            std::to_string(target_error));
+        auto result = std::make_unique<gmpu_mesh>();
+        result->mesh = gmpu::simplify_mesh(mesh->mesh, target_triangles, target_error, nullptr);
+        *out = result.release();
+    });
+}
+
+GMPU_API gmpu_status gmpu_mesh_trim(const gmpu_mesh *mesh, double threshold, gmpu_mesh **out) {
+    using gmpu::Error;
+    return gmpu::api::guarded(nullptr, [&] {
+        gmpu::api::require_arg(out, "out");
+        *out = nullptr;
+        gmpu::api::require_arg(mesh, "mesh");
+        if (!(threshold > 0.0 && std::isfinite(threshold)))
+            throw Error(GMPU_ERROR_INVALID_ARGUMENT,
+                        "threshold must be finite and positive (a distance in sample spacings), not " +
+                            std::to_string(threshold));
+        if (mesh->mesh.confidence.size() != mesh->mesh.vertex_count() || mesh->mesh.confidence.empty())
+            throw Error(GMPU_ERROR_INVALID_ARGUMENT,
+                        "the mesh has no confidence to trim by (only gmpu_surface_polygonize makes one)");
+        auto result = std::make_unique<gmpu_mesh>();
+        result->mesh = gmpu::trim_unsupported(mesh->mesh, threshold);
+        *out = result.release();
+    });
+}
+
 GMPU_API gmpu_status gmpu_mesh_write(const gmpu_mesh *mesh, const char *path) {
     return gmpu::api::guarded(nullptr, [&] {
         gmpu::api::require_arg(mesh, "mesh");
@@ -90,6 +136,7 @@ GMPU_API gmpu_status gmpu_mesh_write(const gmpu_mesh *mesh, const char *path) {
         view.triangle_count = m.triangle_count();
         // A mesh's normals are per vertex; without a full set, write none.
         view.normals = m.normals.size() == m.vertices.size() && !m.normals.empty() ? m.normals.data() : nullptr;
+        view.confidence = m.confidence.size() == m.vertex_count() && !m.confidence.empty() ? m.confidence.data() : nullptr;
         gmpu::io::write_mesh(path, view);
     });
 }

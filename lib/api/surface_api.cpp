@@ -28,6 +28,7 @@
 #include "implicit/mpu_function.hpp"
 #include "implicit/surface_field.hpp"
 #include "implicit/winding_field.hpp"
+#include "mesh/confidence.hpp"
 #include "mesh/polygonizer.hpp"
 #include "orient/orient.hpp"
 #include "orient/orient_memory.hpp"
@@ -455,6 +456,7 @@ GMPU_API gmpu_status gmpu_surface_polygonize(gmpu_surface *s, gmpu_mesh **out) {
                         "polygonize found no closed surface at resolution " + std::to_string(resolution) +
                             " (no piece of the zero set is near enough input points): the points may be "
                             "too few or too sparse for a solid, or the grid too coarse for them");
+        gmpu::compute_confidence(mesh->mesh, s->points, s->measures, s->params.threads, progress);
         finish_stage(progress);
         s->last_resolution = resolution;
         s->seconds[GMPU_STAGE_POLYGONIZE] = since(t0);

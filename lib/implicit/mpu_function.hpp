@@ -11,7 +11,11 @@
 // Where no leaf covers x (far from the data) the deepest cell that does cover it stands in
 // (its coarser fit is the best estimate there); beyond the root's ball, the root's fit.
 // (Far from the data the field the library hands out is signed otherwise anyway, see
-// surface_field.hpp.) A level cap L (paper Fig. 7) treats the cells of level L as leaves.
+// surface_field.hpp.) A level cap L (paper Fig. 7) treats the cells of level L as leaves,
+// except those whose own fit misses their points by more than kCoarseFitTolerance of the
+// cell's size: such a fit does not have the shape of the data (it bridges two sheets,
+// say), and blending it in changes the topology (extra handles and pieces); below it the
+// deeper cells stand in, down to where the fit is good enough or to the leaves.
 #pragma once
 
 #include <vector>
@@ -22,6 +26,11 @@
 #include "geometry/octree.hpp"
 
 namespace gmpu {
+
+// The largest Taubin error, as a fraction of the cell's edge, at which a cell of the level
+// cap stands for its subtree: the shared clouds keep the components and genus of the full
+// surface at every cap from 5 to 7 with it (tests/c/test_meshes.cpp); 0.1 does not.
+constexpr double kCoarseFitTolerance = 0.07;
 
 class MpuFunction {
 public:
@@ -44,7 +53,9 @@ public:
     const Octree &tree() const { return tree_; }
 
 private:
-    bool is_leaf(const Cell &c) const { return c.is_leaf() || c.depth >= cap_; }
+    bool is_leaf(const Cell &c) const {
+        return c.is_leaf() || (c.depth >= cap_ && c.error <= kCoarseFitTolerance * c.size);
+    }
     bool covers(const Cell &c, const Eigen::Vector3d &x) const {
         return (x - c.centre).squaredNorm() < c.radius * c.radius;
     }

@@ -41,6 +41,7 @@ struct MeshView {
     const uint32_t *triangles = nullptr;
     size_t triangle_count = 0;
     const double *normals = nullptr;
+    const double *confidence = nullptr;  // per vertex; written by .ply only (float property)
 };
 
 // .ply (ascii, binary_little_endian, binary_big_endian), .xyz/.txt (3 or 6 columns),

@@ -1,5 +1,5 @@
 // PLY output: binary little-endian, double x y z (so a write → read round trip is exact),
-// optional double nx ny nz, and for meshes `element face` with `list uchar int
+// optional double nx ny nz, optional float confidence, and for meshes `element face` with `list uchar int
 // vertex_indices` (the most widely read layout).
 #include <cstring>
 #include <string>
@@ -30,18 +30,21 @@ void write_ply(AtomicFile &out, const MeshView &mesh, bool faces) {
         std::to_string(mesh.vertex_count) +
         "\nproperty double x\nproperty double y\nproperty double z\n";
     if (mesh.normals) header += "property double nx\nproperty double ny\nproperty double nz\n";
+    // Float: a confidence is a ratio of distances, read by viewers as a scalar colour map.
+    if (mesh.confidence) header += "property float confidence\n";
     if (faces)
         header += "element face " + std::to_string(mesh.triangle_count) +
                   "\nproperty list uchar int vertex_indices\n";
     header += "end_header\n";
     out.write(header);
 
-    char record[48];
+    char record[64];
     for (size_t i = 0; i < mesh.vertex_count; ++i) {
         char *p = record;
         for (size_t k = 0; k < 3; ++k) p = put_le(p, mesh.vertices[3 * i + k]);
         if (mesh.normals)
             for (size_t k = 0; k < 3; ++k) p = put_le(p, mesh.normals[3 * i + k]);
+        if (mesh.confidence) p = put_le(p, static_cast<float>(mesh.confidence[i]));
         out.write(record, static_cast<size_t>(p - record));
     }
     if (!faces) return;

@@ -268,11 +268,11 @@ void sphere_that_subdivides(void **) {
     assert_true(check.signed_volume > 0);
 }
 
-// GMPU_PARAM_LEVEL on one fitted, oriented surface: the mesh at every level is closed; from
-// the coarsest level whose cells can hold the shape on, it has the shape's topology, and
-// all levels together are far closer to the truth than the coarsest. Level 1 (eight cells)
-// cannot hold a torus: it comes out closed but with genus 4 (measured); from level 2 on the
-// torus is a torus. A sphere is one at every level.
+// GMPU_PARAM_LEVEL on one fitted, oriented surface: the mesh at every level is closed and
+// has the shape's topology, and all levels together are closer to the truth than the
+// coarsest. Level 1's eight cells alone cannot hold a torus (their blend has genus 4), but
+// a capped cell whose fit misses its points by much is replaced by its children, so the
+// torus stays a torus at every level. A sphere is one at every level.
 void level_of_detail_keeps_topology(void **) {
     const Torus torus({0, 0, 0}, 1.0, 0.3);
     const Sphere sphere({0, 0, 0}, 1.0);
@@ -280,7 +280,7 @@ void level_of_detail_keeps_topology(void **) {
         const AnalyticShape *shape;
         int genus;
         int first_level;  // the coarsest level whose mesh has the shape's topology
-    } cases[] = {{&torus, 1, 2}, {&sphere, 0, 1}};
+    } cases[] = {{&torus, 1, 1}, {&sphere, 0, 1}};
     for (const Case &c : cases) {
         OrientedPoints pts = c.shape->sample(20000, 21);
         add_gaussian_noise(pts.positions, 0.0005, 22);  // a sphere must subdivide too (above)
@@ -305,7 +305,7 @@ void level_of_detail_keeps_topology(void **) {
                     int(check.watertight), d.mean_distance);
             assert_true(check.watertight);  // at every level, even below first_level
             if (level == 1) coarsest = d.mean_distance;
-            if (cap == 0) assert_true(d.mean_distance < 0.1 * coarsest);
+            if (cap == 0) assert_true(d.mean_distance < 0.5 * coarsest);
             if (level < c.first_level) continue;
             assert_int_equal(check.components, 1);
             assert_int_equal(check.component_reports[0].genus, c.genus);

@@ -118,6 +118,9 @@ function declare(lib) {
         mesh_normals: f('void *', 'gmpu_mesh_normals', ['void *']),
         mesh_triangles: f('void *', 'gmpu_mesh_triangles', ['void *']),
         mesh_write: f('int', 'gmpu_mesh_write', ['void *', 'const char *']),
+        mesh_confidence: f('void *', 'gmpu_mesh_confidence', ['void *']),
+        mesh_simplify: f('int', 'gmpu_mesh_simplify', ['void *', 'size_t', 'double', outPtr]),
+        mesh_trim: f('int', 'gmpu_mesh_trim', ['void *', 'double', outPtr]),
 
         points_read: f('int', 'gmpu_points_read', ['const char *', outPtr]),
         points_read_with: f('int', 'gmpu_points_read_with',

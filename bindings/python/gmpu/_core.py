@@ -139,6 +139,7 @@ class Mesh:
             if n.shape != v.shape:
                 raise ValueError(f"normals: expected shape {v.shape} (one per vertex), got {n.shape}")
         self._vertices, self._faces, self._normals = v, f, n
+        self._confidence = None
         self._handle = None  # the gmpu_mesh these arrays view, when made by the library
 
     @classmethod
@@ -153,6 +154,8 @@ class Mesh:
         self._faces = view_of_c_memory(handle, lib.gmpu_mesh_triangles(handle), (nt, 3), np.uint32)
         normals = lib.gmpu_mesh_normals(handle)
         self._normals = None if normals == ffi.NULL else view_of_c_memory(handle, normals, (nv, 3), np.float64)
+        confidence = lib.gmpu_mesh_confidence(handle)
+        self._confidence = None if confidence == ffi.NULL else view_of_c_memory(handle, confidence, (nv,), np.float64)
         return self
 
     @property
@@ -169,6 +172,53 @@ class Mesh:
     def normals(self) -> Optional[NDArray[np.float64]]:
         """n×3 float64 unit outward vertex normals, or None."""
         return self._normals
+
+    @property
+    def confidence(self) -> Optional[NDArray[np.float64]]:
+        """n float64: each vertex's distance to the nearest input point in sample spacings
+        (about 0.5 or less on sampled surface, several over a scan's holes), or None for a
+        mesh built from arrays."""
+        return self._confidence
+
+    def _with_c_mesh(self, call):
+        """call(gmpu_mesh*) on this mesh's library copy (made for the call when built from arrays)."""
+        if self._handle is not None:
+            return call(self._handle)
+        out = ffi.new("gmpu_mesh **")
+        v, f = self._vertices, self._faces
+        check(lib.gmpu_mesh_create(double_ptr(v), len(v), uint32_ptr(f), len(f), out), "gmpu_mesh_create")
+        mesh = ffi.gc(out[0], lib.gmpu_mesh_destroy)
+        try:
+            return call(mesh)
+        finally:
+            ffi.release(mesh)
+
+    def simplify(self, target_triangles: int = 0, target_error: float = 1.0) -> "Mesh":
+        """A decimated copy: at most ``target_triangles`` triangles (0: no count target) with
+        the surface moved by at most ``target_error`` × the bounding-box diagonal. Keeps the
+        topology (closed, manifold, components, genus), so it may stop above the count.
+        Normals are recomputed; confidence is carried. Raises gmpu.InvalidArgumentError."""
+        if isinstance(target_triangles, bool) or int(target_triangles) != target_triangles or target_triangles < 0:
+            raise ValueError(f"target_triangles: expected a non-negative integer, got {target_triangles!r}")
+        out = ffi.new("gmpu_mesh **")
+
+        def call(handle):
+            check(lib.gmpu_mesh_simplify(handle, int(target_triangles), float(target_error), out),
+                  "gmpu_mesh_simplify")
+        self._with_c_mesh(call)
+        return Mesh._from_c(out[0])
+
+    def trim(self, threshold: float = 3.0) -> "Mesh":
+        """A copy without the triangles that have a vertex whose confidence is above
+        ``threshold`` sample spacings: the caps polygonize puts over a scan's holes go, leaving
+        boundaries. Only meshes made by polygonize carry a confidence; others raise
+        gmpu.InvalidArgumentError."""
+        out = ffi.new("gmpu_mesh **")
+
+        def call(handle):
+            check(lib.gmpu_mesh_trim(handle, float(threshold), out), "gmpu_mesh_trim")
+        self._with_c_mesh(call)
+        return Mesh._from_c(out[0])
 
     def __repr__(self) -> str:
         return f"<gmpu.Mesh {len(self._vertices)} vertices, {len(self._faces)} faces>"

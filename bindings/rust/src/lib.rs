@@ -939,6 +939,40 @@ impl Mesh {
         unsafe { triples(sys::gmpu_mesh_triangles(self.raw.as_ptr()), self.triangle_count()) }
     }
 
+    /// Per vertex: distance to the nearest input point in sample spacings (about 0.5 or
+    /// less on sampled surface, several over a scan's holes); `None` for a mesh made by
+    /// [`Mesh::new`].
+    pub fn confidence(&self) -> Option<&[f64]> {
+        // SAFETY: NULL or vertex_count doubles owned by the mesh.
+        let p = unsafe { sys::gmpu_mesh_confidence(self.raw.as_ptr()) };
+        (!p.is_null()).then(|| unsafe { std::slice::from_raw_parts(p, self.vertex_count()) })
+    }
+
+    /// A decimated copy: at most `target_triangles` triangles (0: no count target), the
+    /// surface moved by at most `target_error` × the bounding-box diagonal (1: no bound).
+    /// Topology is kept (closed, manifold, components, genus), so it may stop above the
+    /// count. Normals are recomputed, confidence carried. Fails with
+    /// [`Status::InvalidArgument`] for `target_error` outside [0, 1].
+    pub fn simplify(&self, target_triangles: usize, target_error: f64) -> Result<Mesh> {
+        let mut raw = ptr::null_mut();
+        // SAFETY: valid handle and out pointer.
+        check(unsafe { sys::gmpu_mesh_simplify(self.raw.as_ptr(), target_triangles, target_error, &mut raw) })?;
+        // SAFETY: a new mesh we own.
+        unsafe { Mesh::from_raw(raw) }
+    }
+
+    /// A copy without the triangles that have a vertex whose confidence is above
+    /// `threshold` sample spacings (3 is a good start): the caps over a scan's holes go,
+    /// leaving boundaries. Fails with [`Status::InvalidArgument`] for a mesh without
+    /// confidence (made by [`Mesh::new`]) or a threshold that is not finite and positive.
+    pub fn trim(&self, threshold: f64) -> Result<Mesh> {
+        let mut raw = ptr::null_mut();
+        // SAFETY: valid handle and out pointer.
+        check(unsafe { sys::gmpu_mesh_trim(self.raw.as_ptr(), threshold, &mut raw) })?;
+        // SAFETY: a new mesh we own.
+        unsafe { Mesh::from_raw(raw) }
+    }
+
     /// Writes the mesh; the format comes from the extension (`.ply` binary little-endian,
     /// `.obj`, `.off`). Atomic: a failure never leaves a partial file.
     pub fn write(&self, path: impl AsRef<Path>) -> Result<()> {

@@ -238,6 +238,10 @@ c_functions! {
     pub fn gmpu_mesh_normals(mesh: *const gmpu_mesh) -> *const f64;
     pub fn gmpu_mesh_triangles(mesh: *const gmpu_mesh) -> *const u32;
     pub fn gmpu_mesh_write(mesh: *const gmpu_mesh, path: *const c_char) -> gmpu_status;
+    pub fn gmpu_mesh_confidence(mesh: *const gmpu_mesh) -> *const f64;
+    pub fn gmpu_mesh_simplify(mesh: *const gmpu_mesh, target_triangles: usize, target_error: f64,
+                              out: *mut *mut gmpu_mesh) -> gmpu_status;
+    pub fn gmpu_mesh_trim(mesh: *const gmpu_mesh, threshold: f64, out: *mut *mut gmpu_mesh) -> gmpu_status;
 
     pub fn gmpu_points_read(path: *const c_char, out: *mut *mut gmpu_points) -> gmpu_status;
     pub fn gmpu_points_read_with(

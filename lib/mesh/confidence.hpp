@@ -1,0 +1,25 @@
+// How well the input supports each part of the mesh, and trimming what it does not.
+// Polygonize closes every surface, inventing caps over the holes of an open scan; a
+// vertex far from every input point, compared with the spacing of the points there, lies
+// on such a cap.
+#pragma once
+
+#include "core/progress.hpp"
+#include "geometry/point_set.hpp"
+#include "implicit/surface_field.hpp"
+#include "mesh/mesh.hpp"
+
+namespace gmpu {
+
+// Per vertex: distance to the nearest input point divided by that point's sample spacing
+// (the square root of the area it stands for). About 0.5 or less on sampled surface;
+// several where the surface bridges a hole. Fills mesh.confidence.
+void compute_confidence(Mesh &mesh, const PointSet &points, const PointMeasures &measures, unsigned threads,
+                        Progress &progress);
+
+// Removes every triangle with a vertex whose confidence is above `threshold`, and the
+// vertices left unused: the caps over holes go, leaving boundaries where the data ends.
+// The mesh must carry a confidence.
+Mesh trim_unsupported(const Mesh &mesh, double threshold);
+
+}  // namespace gmpu

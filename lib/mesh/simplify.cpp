@@ -1,0 +1,189 @@
+#include "mesh/simplify.hpp"
+
+#include <meshoptimizer.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "mesh/mesh_topology.hpp"
+
+namespace gmpu {
+
+namespace {
+
+// A round that breaks the topology is redone with more vertices locked, this many times in
+// a row at most, before simplification stops where it is.
+constexpr int kRetries = 12;
+
+// Vertices at identical positions become one, so that collapses see the true neighbourhood
+// (a duplicate would look like a border and be locked or torn). Degenerate triangles go.
+Mesh welded(const Mesh &in) {
+    const size_t n = in.vertex_count();
+    std::vector<unsigned> remap(n);
+    const size_t unique = meshopt_generateVertexRemap(remap.data(), in.triangles.data(), in.triangles.size(),
+                                                      in.vertices.data(), n, 3 * sizeof(double));
+    Mesh out;
+    out.vertices.resize(3 * unique);
+    if (!in.confidence.empty()) out.confidence.resize(unique);
+    for (size_t v = 0; v < n; ++v) {
+        if (remap[v] == ~0u) continue;
+        for (int d = 0; d < 3; ++d) out.vertices[3 * remap[v] + d] = in.vertices[3 * v + d];
+        if (!in.confidence.empty()) out.confidence[remap[v]] = in.confidence[v];
+    }
+    out.triangles.reserve(in.triangles.size());
+    for (size_t t = 0; t < in.triangles.size(); t += 3) {
+        const unsigned a = remap[in.triangles[t]], b = remap[in.triangles[t + 1]], c = remap[in.triangles[t + 2]];
+        if (a == b || b == c || c == a) continue;
+        out.triangles.insert(out.triangles.end(), {a, b, c});
+    }
+    return out;
+}
+
+// Keeps only the vertices `triangles` uses, in their order.
+Mesh compacted(const Mesh &base, const std::vector<uint32_t> &triangles) {
+    std::vector<uint32_t> index(base.vertex_count(), UINT32_MAX);
+    Mesh out;
+    out.triangles.reserve(triangles.size());
+    for (uint32_t v : triangles) {
+        if (index[v] == UINT32_MAX) {
+            index[v] = uint32_t(out.vertices.size() / 3);
+            out.vertices.insert(out.vertices.end(), base.vertices.begin() + 3 * v, base.vertices.begin() + 3 * v + 3);
+            if (!base.confidence.empty()) out.confidence.push_back(base.confidence[v]);
+        }
+        out.triangles.push_back(index[v]);
+    }
+    return out;
+}
+
+double bbox_diagonal(const std::vector<double> &xyz) {
+    if (xyz.empty()) return 0.0;
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(INFINITY), hi = -lo;
+    for (size_t i = 0; i < xyz.size(); i += 3) {
+        const Eigen::Vector3d p(xyz[i], xyz[i + 1], xyz[i + 2]);
+        lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+    }
+    return (hi - lo).norm();
+}
+
+}  // namespace
+
+void recompute_normals(Mesh &mesh, const Mesh *fallback) {
+    const size_t n = mesh.vertex_count();
+    std::vector<Eigen::Vector3d> sum(n, Eigen::Vector3d::Zero());
+    auto at = [&](uint32_t v) { return Eigen::Vector3d(mesh.vertices[3 * v], mesh.vertices[3 * v + 1], mesh.vertices[3 * v + 2]); };
+    for (size_t t = 0; t < mesh.triangles.size(); t += 3) {
+        const uint32_t a = mesh.triangles[t], b = mesh.triangles[t + 1], c = mesh.triangles[t + 2];
+        // The cross product's length is twice the area: the weight.
+        const Eigen::Vector3d w = (at(b) - at(a)).cross(at(c) - at(a));
+        sum[a] += w, sum[b] += w, sum[c] += w;
+    }
+    mesh.normals.assign(3 * n, 0.0);
+    for (size_t v = 0; v < n; ++v) {
+        Eigen::Vector3d u(0, 0, 1);
+        const double len = sum[v].norm();
+        if (len > 0 && std::isfinite(len)) u = sum[v] / len;
+        else if (fallback && fallback->normals.size() == 3 * fallback->vertex_count() && v < fallback->vertex_count())
+            u = Eigen::Vector3d(fallback->normals[3 * v], fallback->normals[3 * v + 1], fallback->normals[3 * v + 2]);
+        for (int d = 0; d < 3; ++d) mesh.normals[3 * v + d] = u[d];
+    }
+}
+
+namespace {
+
+// One meshopt_simplify run on `triangles` with the `locked` vertices kept in place.
+// meshopt 0.18 locks only border vertices, so each locked vertex is made one: one of its
+// corners gets a copy of it whose float position differs in the last bit (meshopt matches
+// vertices by exact position), which opens the edges of that corner. The copies map back.
+size_t collapse_round(const std::vector<uint32_t> &triangles, const std::vector<float> &positions,
+                      const std::vector<char> &locked, size_t target_triangles, double error,
+                      std::vector<uint32_t> &out, float &result_error) {
+    const size_t n = positions.size() / 3;
+    std::vector<uint32_t> in = triangles;
+    std::vector<float> pos = positions;
+    std::vector<uint32_t> original;  // of each copy
+    std::vector<char> done(n, 0);
+    for (uint32_t &v : in) {
+        if (!locked[v] || done[v]) continue;
+        done[v] = 1;
+        original.push_back(v);
+        const float x = pos[3 * v];
+        pos.insert(pos.end(), {std::nextafter(x, std::numeric_limits<float>::infinity()), pos[3 * v + 1], pos[3 * v + 2]});
+        v = uint32_t(n + original.size() - 1);
+    }
+    out.resize(in.size());
+    const size_t got = meshopt_simplify(out.data(), in.data(), in.size(), pos.data(), pos.size() / 3,
+                                        3 * sizeof(float), 3 * target_triangles, float(error),
+                                        meshopt_SimplifyLockBorder, &result_error);
+    out.resize(got);
+    for (uint32_t &v : out)
+        if (v >= n) v = original[v - n];
+    return got / 3;
+}
+
+}  // namespace
+
+Mesh simplify_mesh(const Mesh &mesh, size_t target_triangles, double target_error, double *achieved_error) {
+    if (achieved_error) *achieved_error = 0.0;
+    if (mesh.triangles.empty()) return Mesh();  // nothing to weld or collapse (and no vertex in use)
+    Mesh base = welded(mesh);
+    const MeshTopology before = mesh_topology(base);
+    std::vector<float> positions(base.vertices.begin(), base.vertices.end());
+    const size_t n = base.vertex_count();
+    // meshopt measures error relative to its own scale (the largest extent); ours is the
+    // diagonal.
+    const double diagonal = bbox_diagonal(base.vertices);
+    const double scale = n ? double(meshopt_simplifyScale(positions.data(), n, 3 * sizeof(float))) : 0.0;
+    const double to_meshopt = scale > 0 ? diagonal / scale : 0.0;
+
+    std::vector<uint32_t> current = base.triangles, next, culprits;
+    std::vector<char> locked(n, 0);
+    double spent = 0.0;  // error bound used so far (rounds add up: triangle inequality)
+    int failures = 0;
+    size_t ask = target_triangles;  // of this round: more than the target after a failure
+    Mesh probe;
+    probe.vertices = base.vertices;
+    while (current.size() / 3 > target_triangles && failures <= kRetries && spent <= target_error) {
+        float round_error = 0.0f;
+        const size_t got = collapse_round(current, positions, locked, ask,
+                                          (target_error - spent) * to_meshopt, next, round_error);
+        if (3 * got >= current.size()) break;  // the error bound (or the locks) allow no collapse
+        probe.triangles = next;
+        culprits.clear();
+        if (mesh_topology(probe, &culprits).same_as(before)) {
+            current.swap(next);
+            spent += to_meshopt > 0 ? double(round_error) / to_meshopt : 0.0;
+            failures = 0;
+            ask = target_triangles;
+            continue;
+        }
+        // Some collapse broke the topology (meshoptimizer does not test the link
+        // condition). Lock where it went wrong, with the neighbours that could collapse
+        // there, and redo the round from the last good mesh.
+        ++failures;
+        if (culprits.empty()) {
+            // A change with no local sign (a handle closed cleanly): ask for half the
+            // reduction, fewer collapses and fewer chances of the bad one.
+            const size_t have = current.size() / 3;
+            ask = have - (have - ask) / 2;
+            if (ask >= have) break;
+            continue;
+        }
+        std::vector<char> bad(n, 0);
+        for (uint32_t v : culprits) bad[v] = 1;
+        for (const std::vector<uint32_t> *tris : {&current, &next})
+            for (size_t t = 0; t < tris->size(); t += 3)
+                if (bad[(*tris)[t]] || bad[(*tris)[t + 1]] || bad[(*tris)[t + 2]])
+                    for (int k = 0; k < 3; ++k) locked[(*tris)[t + k]] = 1;
+    }
+    Mesh out = compacted(base, current);
+    recompute_normals(out);
+    if (achieved_error) *achieved_error = spent;
+    return out;
+}
+
+}  // namespace gmpu

@@ -1,0 +1,267 @@
+// Meshes after polygonize: decimation (gmpu_mesh_simplify) keeps the topology and the
+// shape within its error bound; per-vertex confidence marks surface no point supports, and
+// trimming by it opens the caps polygonize puts over a scan's holes; the level-of-detail
+// cap keeps the components and genus of the full surface.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <string>
+#include <unistd.h>
+#include <vector>
+
+#include "aabb_tree.hpp"
+#include "analytic_shapes.hpp"
+#include "files.hpp"
+#include "mesh_checks.hpp"
+#include "reconstruct.hpp"
+#include "triangle_mesh.hpp"
+
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+extern "C" {
+#include <cmocka.h>
+}
+
+using namespace gmpu::testing;
+
+namespace {
+
+// set_points → fit → orient → polygonize; the library's mesh (NULL on failure).
+gmpu_mesh *polygonize(const std::vector<Vec3> &points, const std::vector<std::pair<gmpu_param, double>> &params = {}) {
+    gmpu_surface *s = nullptr;
+    gmpu_mesh *mesh = nullptr;
+    if (gmpu_surface_create(&s) != GMPU_OK) return nullptr;
+    bool ok = true;
+    for (const auto &[key, value] : params) ok = ok && gmpu_surface_set_param(s, key, value) == GMPU_OK;
+    ok = ok && gmpu_surface_set_points_f64(s, points[0].data(), points.size(), sizeof(Vec3)) == GMPU_OK &&
+         gmpu_surface_fit(s) == GMPU_OK && gmpu_surface_orient(s) == GMPU_OK &&
+         gmpu_surface_polygonize(s, &mesh) == GMPU_OK;
+    if (!ok) fprintf(stderr, "reconstruction failed: %s\n", gmpu_last_error());
+    gmpu_surface_destroy(s);
+    return mesh;
+}
+
+TriangleMesh arrays(const gmpu_mesh *m) {
+    return mesh_from_arrays(gmpu_mesh_vertices(m), gmpu_mesh_vertex_count(m), gmpu_mesh_triangles(m),
+                            gmpu_mesh_triangle_count(m));
+}
+
+// Largest distance from any vertex of `from` to the surface of `to`.
+double one_sided_distance(const TriangleMesh &from, const TriangleMesh &to) {
+    AabbTree tree(to);
+    double worst = 0;
+    for (const auto &n : tree.nearest_all(from.vertices, 1)) worst = std::max(worst, n.distance);
+    return worst;
+}
+
+std::vector<int> genera(const MeshCheck &c) {
+    std::vector<int> g;
+    for (const auto &r : c.component_reports) g.push_back(r.genus);
+    std::sort(g.begin(), g.end());
+    return g;
+}
+
+// Decimates `mesh` and checks every promise of gmpu_mesh_simplify.
+void check_simplify(const gmpu_mesh *mesh, size_t target, double error, bool expect_target) {
+    const TriangleMesh before = arrays(mesh);
+    const MeshCheck cb = check_mesh(before);
+    gmpu_mesh *out = nullptr;
+    assert_int_equal(gmpu_mesh_simplify(mesh, target, error, &out), GMPU_OK);
+    assert_non_null(out);
+    const TriangleMesh after = arrays(out);
+    const MeshCheck ca = check_mesh(after);
+    const double diag = bbox_diagonal(before);
+    const double d_out = one_sided_distance(after, before) / diag, d_in = one_sided_distance(before, after) / diag;
+    fprintf(stderr, "  %zu -> %zu triangles (target %zu, error %g): distance %.4f%% / %.4f%% of the diagonal\n",
+            before.triangles.size(), after.triangles.size(), target, error, 100 * d_out, 100 * d_in);
+    assert_true(ca.watertight);
+    assert_int_equal(ca.nonmanifold_vertices, 0);
+    assert_int_equal(ca.components, cb.components);
+    assert_true(genera(ca) == genera(cb));
+    assert_true(ca.signed_volume > 0);
+    if (expect_target) assert_true(after.triangles.size() <= target);
+    // The quadric error bounds the distance to the planes of the original triangles, not to
+    // the triangles themselves: twice the bound plus the original's own facet scale.
+    assert_true(d_out <= 2 * error + 0.005);
+    assert_true(d_in <= 2 * error + 0.005);
+    // Normals recomputed (unit), confidence carried.
+    const double *n = gmpu_mesh_normals(out);
+    assert_non_null(n);
+    for (size_t v = 0; v < gmpu_mesh_vertex_count(out); ++v)
+        assert_true(std::fabs(std::hypot(n[3 * v], n[3 * v + 1], n[3 * v + 2]) - 1) < 1e-9);
+    assert_true((gmpu_mesh_confidence(mesh) != nullptr) == (gmpu_mesh_confidence(out) != nullptr));
+    gmpu_mesh_destroy(out);
+}
+
+void simplify_sphere_to_a_tenth(void **) {
+    gmpu_mesh *m = polygonize(Sphere(Vec3(0.3, -1, 2), 1.5).sample(4000, 3).positions);
+    assert_non_null(m);
+    const size_t target = gmpu_mesh_triangle_count(m) / 10;
+    check_simplify(m, target, 0.01, true);
+    gmpu_mesh_destroy(m);
+}
+
+// A handle makes collapses that close it tempting: at a few dozen triangles some would.
+void simplify_torus_keeps_the_handle(void **) {
+    gmpu_mesh *m = polygonize(Torus(Vec3(0, 0, 0), 1.0, 0.35).sample(5000, 5).positions);
+    assert_non_null(m);
+    check_simplify(m, gmpu_mesh_triangle_count(m) / 10, 0.01, true);
+    check_simplify(m, 8, 1.0, false);
+    gmpu_mesh_destroy(m);
+}
+
+void simplify_error_bound_alone(void **) {
+    gmpu_mesh *m = polygonize(Sphere(Vec3(0, 0, 0), 1).sample(3000, 4).positions);
+    assert_non_null(m);
+    check_simplify(m, 0, 0.002, false);
+    gmpu_mesh_destroy(m);
+}
+
+void simplify_bad_arguments(void **) {
+    const double v[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const uint32_t t[] = {0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3};
+    gmpu_mesh *m = nullptr, *out = nullptr;
+    assert_int_equal(gmpu_mesh_create(v, 4, t, 4, &m), GMPU_OK);
+    assert_int_equal(gmpu_mesh_simplify(nullptr, 1, 0.1, &out), GMPU_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(gmpu_mesh_simplify(m, 1, 0.1, nullptr), GMPU_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(gmpu_mesh_simplify(m, 1, NAN, &out), GMPU_ERROR_INVALID_ARGUMENT);
+    assert_int_equal(gmpu_mesh_simplify(m, 1, -0.1, &out), GMPU_ERROR_INVALID_ARGUMENT);
+    assert_null(out);
+    assert_non_null(strstr(gmpu_last_error(), "target_error"));
+    // A tetrahedron cannot lose a triangle and stay a closed surface with volume.
+    assert_int_equal(gmpu_mesh_simplify(m, 1, 1.0, &out), GMPU_OK);
+    assert_int_equal(gmpu_mesh_triangle_count(out), 4);
+    assert_null(gmpu_mesh_confidence(m));
+    assert_null(gmpu_mesh_confidence(out));
+    gmpu_mesh_destroy(out);
+    out = nullptr;
+    // Vertices without triangles: nothing to simplify, an empty mesh.
+    gmpu_mesh *points_only = nullptr;
+    assert_int_equal(gmpu_mesh_create(v, 4, nullptr, 0, &points_only), GMPU_OK);
+    assert_int_equal(gmpu_mesh_simplify(points_only, 0, 0.0, &out), GMPU_OK);
+    assert_int_equal(gmpu_mesh_triangle_count(out), 0);
+    gmpu_mesh_destroy(out);
+    gmpu_mesh_destroy(points_only);
+    out = nullptr;
+    assert_int_equal(gmpu_mesh_trim(m, 3.0, &out), GMPU_ERROR_INVALID_ARGUMENT);
+    assert_non_null(strstr(gmpu_last_error(), "confidence"));
+    assert_null(out);
+    gmpu_mesh_destroy(m);
+}
+
+// A sphere scanned all but a cap (z > 0.6 r): polygonize closes it; trim opens it again,
+// leaving a disc (one boundary loop) that ends near the rim of the missing cap.
+void trim_opens_the_hole(void **) {
+    const double r = 1.0, rim = 0.6;
+    std::vector<Vec3> pts;
+    for (const Vec3 &p : Sphere(Vec3(0, 0, 0), r).sample(6000, 9).positions)
+        if (p.z() < rim * r) pts.push_back(p);
+    gmpu_mesh *m = polygonize(pts);
+    assert_non_null(m);
+    assert_true(check_mesh(arrays(m)).watertight);
+    const double *c = gmpu_mesh_confidence(m);
+    assert_non_null(c);
+    // The implicit closes the hole by folding inward (a second, inner sheet): no point is
+    // near it. On the scanned part every vertex is within a sample spacing or two.
+    const double *v = gmpu_mesh_vertices(m);
+    double worst_supported = 0, best_unsupported = INFINITY;
+    for (size_t i = 0; i < gmpu_mesh_vertex_count(m); ++i) {
+        const double radius = std::hypot(v[3 * i], v[3 * i + 1], v[3 * i + 2]);
+        if (std::fabs(radius - r) < 0.03 * r && v[3 * i + 2] < rim - 0.1) worst_supported = std::max(worst_supported, c[i]);
+        if (radius < 0.8 * r || v[3 * i + 2] > 0.85 * r) best_unsupported = std::min(best_unsupported, c[i]);
+    }
+    fprintf(stderr, "  confidence: at most %.2f on the scanned part, at least %.2f off it\n", worst_supported,
+            best_unsupported);
+    assert_true(worst_supported < 2.5);
+    assert_true(std::isfinite(best_unsupported) && best_unsupported > 3.0);
+
+    gmpu_mesh *trimmed = nullptr;
+    assert_int_equal(gmpu_mesh_trim(m, 3.0, &trimmed), GMPU_OK);
+    const TriangleMesh t = arrays(trimmed);
+    const MeshCheck ct = check_mesh(t);
+    fprintf(stderr, "  trimmed: %zu -> %zu triangles, %zu boundary edges\n", gmpu_mesh_triangle_count(m),
+            t.triangles.size(), ct.boundary_edges);
+    assert_false(ct.watertight);
+    assert_true(ct.boundary_edges > 20);
+    assert_int_equal(ct.nonmanifold_edges, 0);
+    assert_int_equal(ct.components, 1);
+    // χ = 1: a disc, i.e. one boundary loop on a sphere.
+    assert_int_equal(ct.euler_characteristic, 1);
+    // What is left is the scanned part: nothing above the rim but a strip along it, and
+    // the bottom kept.
+    double lowest = INFINITY, highest = -INFINITY;
+    for (const Vec3 &p : t.vertices) lowest = std::min(lowest, p.z()), highest = std::max(highest, p.z());
+    fprintf(stderr, "  trimmed mesh spans z in [%.3f, %.3f]\n", lowest, highest);
+    assert_true(lowest < -0.9 * r);
+    assert_true(highest < rim + 0.25);
+    for (const Vec3 &p : t.vertices) assert_true(std::fabs(p.norm() - r) < 0.1 * r);
+    gmpu_mesh_destroy(trimmed);
+    gmpu_mesh_destroy(m);
+}
+
+// The confidence is a float property of the .ply the mesh writes.
+void confidence_in_ply(void **) {
+    gmpu_mesh *m = polygonize(Sphere(Vec3(0, 0, 0), 1).sample(2000, 2).positions);
+    assert_non_null(m);
+    char path[] = "/tmp/gmpu_meshes_XXXXXX.ply";
+    int fd = mkstemps(path, 4);
+    assert_true(fd >= 0);
+    close(fd);
+    assert_int_equal(gmpu_mesh_write(m, path), GMPU_OK);
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    char header[512] = {0};
+    assert_true(fread(header, 1, sizeof header - 1, f) > 0);
+    fclose(f);
+    remove(path);
+    assert_non_null(strstr(header, "property float confidence\n"));
+    gmpu_mesh_destroy(m);
+}
+
+// bunny_clean (35k points) at level caps 5 and 6 has the full surface's components and
+// genus: capped cells whose fit does not have the shape of their points are not used.
+void level_of_detail_keeps_the_topology_of_the_full_surface(void **) {
+    const OrientedPoints cloud = load_points(test_data("clouds/bunny_clean.ply"));
+    gmpu_surface *s = nullptr;
+    assert_int_equal(gmpu_surface_create(&s), GMPU_OK);
+    assert_int_equal(gmpu_surface_set_points_f64(s, cloud.positions[0].data(), cloud.positions.size(), sizeof(Vec3)),
+                     GMPU_OK);
+    assert_int_equal(gmpu_surface_fit(s), GMPU_OK);
+    assert_int_equal(gmpu_surface_orient(s), GMPU_OK);
+    MeshCheck full;
+    for (int level : {0, 5, 6}) {
+        assert_int_equal(gmpu_surface_set_param(s, GMPU_PARAM_LEVEL, level), GMPU_OK);
+        gmpu_mesh *m = nullptr;
+        assert_int_equal(gmpu_surface_polygonize(s, &m), GMPU_OK);
+        const MeshCheck c = check_mesh(arrays(m));
+        gmpu_mesh_destroy(m);
+        fprintf(stderr, "  level %d: %zu components, genus of the largest %d\n", level, c.components,
+                c.component_reports.empty() ? -1 : c.component_reports[0].genus);
+        assert_true(c.watertight);
+        if (level == 0) {
+            full = c;
+            continue;
+        }
+        assert_int_equal(c.components, full.components);
+        assert_true(genera(c) == genera(full));
+    }
+    gmpu_surface_destroy(s);
+}
+
+}  // namespace
+
+int main(void) {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(simplify_sphere_to_a_tenth),
+        cmocka_unit_test(simplify_torus_keeps_the_handle),
+        cmocka_unit_test(simplify_error_bound_alone),
+        cmocka_unit_test(simplify_bad_arguments),
+        cmocka_unit_test(trim_opens_the_hole),
+        cmocka_unit_test(confidence_in_ply),
+        cmocka_unit_test(level_of_detail_keeps_the_topology_of_the_full_surface),
+    };
+    return cmocka_run_group_tests(tests, nullptr, nullptr);
+}
