@@ -9,7 +9,7 @@
 
 #include "core/params.hpp"
 #include "core/progress.hpp"
-#include "geometry/octree.hpp"
+#include "model/octree.hpp"
 #include "geometry/point_set.hpp"
 
 namespace gmpu {

@@ -19,7 +19,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "geometry/octree.hpp"
+#include "model/octree.hpp"
 
 namespace gmpu {
 

@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "core/progress.hpp"
-#include "geometry/octree.hpp"
+#include "model/octree.hpp"
 
 namespace gmpu {
 

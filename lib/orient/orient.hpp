@@ -11,7 +11,7 @@
 
 #include "core/params.hpp"
 #include "core/progress.hpp"
-#include "geometry/octree.hpp"
+#include "model/octree.hpp"
 #include "geometry/point_set.hpp"
 #include "implicit/mpu_function.hpp"
 #include "orient/advancing_front.hpp"

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "core/progress.hpp"
-#include "geometry/octree.hpp"
+#include "model/octree.hpp"
 #include "geometry/point_set.hpp"
 #include "orient/leaf_graph.hpp"
 
