@@ -87,7 +87,7 @@ double SurfaceField::value_among(const std::vector<uint32_t> &leaves, const Eige
     return trusted(x) ? mpu_.value_among(leaves, x, gradient) : far_value(x, gradient);
 }
 
-void measure_points(const Octree &tree, const PointSet &points, unsigned threads, Progress &progress,
+void measure_points(const Octree &tree, const PointSet &points, Workers &workers, Progress &progress,
                     PointMeasures &out) {
     const size_t n = points.size();
     assign_reporting(out.area, n, progress);
@@ -99,12 +99,12 @@ void measure_points(const Octree &tree, const PointSet &points, unsigned threads
     if (n <= kExactMeasureLimit) {
         // The k-th neighbour distance of every point: exact, and what sparse or nonuniform
         // clouds need.
-        parallel_for(0, n, threads, progress, [&](size_t i) {
+        parallel_for(0, n, workers, progress, [&](size_t i) {
             thread_local std::vector<uint32_t> idx;
             thread_local std::vector<float> d2;
             points.nearest(points.point(i), kNeighbours + 1, idx, d2);  // includes the point itself
             set(uint32_t(i), std::sqrt(double(d2.back())));
-        }, 0.0, 0.0, 512);
+        }, 512);
         progress.throw_if_cancelled();
     } else {
         // Dense clouds: the density of each leaf's support, as if the surface crossed its ball

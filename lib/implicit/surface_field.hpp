@@ -18,6 +18,8 @@
 
 #include <Eigen/Core>
 
+#include "core/parallel.hpp"
+#include "core/progress.hpp"
 #include "geometry/point_set.hpp"
 #include "implicit/mpu_function.hpp"
 #include "implicit/winding_field.hpp"
@@ -73,7 +75,7 @@ private:
 
 // Area and trust radius of every point, from its k-th neighbour distance (normals are
 // filled in separately).
-void measure_points(const Octree &tree, const PointSet &points, unsigned threads, class Progress &progress,
+void measure_points(const Octree &tree, const PointSet &points, Workers &workers, Progress &progress,
                     PointMeasures &out);
 
 }  // namespace gmpu

@@ -247,14 +247,14 @@ Mesh weld(std::vector<BlockOutput> &blocks, const Normalisation &norm, Progress 
     std::vector<std::pair<uint64_t, uint64_t>> keyed;  // (edge key, block << 32 | local index)
     keyed.reserve(vertex_slots);
     for (size_t b = 0; b < blocks.size(); ++b) {
-        progress.poll(0.95);
+        progress.poll(0.0);
         for (size_t v = 0; v < blocks[b].vertex_key.size(); ++v) keyed.push_back({blocks[b].vertex_key[v], uint64_t(b) << 32 | v});
     }
-    cancellable_sort(keyed, progress, 0.96);
+    cancellable_sort(keyed, progress, 0.3);
 
     size_t welded = 0;
     for (size_t k = 0; k < keyed.size(); ++k) {
-        if (k % 65536 == 0) progress.poll(0.97);
+        if (k % 65536 == 0) progress.poll(0.6);
         welded += k == 0 || keyed[k].first != keyed[k - 1].first;
     }
     Mesh mesh;
@@ -264,11 +264,11 @@ Mesh weld(std::vector<BlockOutput> &blocks, const Normalisation &norm, Progress 
     votes.reserve(welded);
     std::vector<std::vector<uint32_t>> remap(blocks.size());
     for (size_t b = 0; b < blocks.size(); ++b) {
-        progress.poll(0.97);
+        progress.poll(0.6);
         remap[b].resize(blocks[b].vertex_key.size());
     }
     for (size_t k = 0; k < keyed.size(); ++k) {
-        if (k % 4096 == 0) progress.poll(0.97);
+        if (k % 4096 == 0) progress.poll(0.7);
         const size_t b = keyed[k].second >> 32, v = keyed[k].second & 0xffffffffu;
         if (k == 0 || keyed[k].first != keyed[k - 1].first) {
             const Eigen::Vector3d p = norm.to_world(blocks[b].vertex_pos[v]);
@@ -282,7 +282,7 @@ Mesh weld(std::vector<BlockOutput> &blocks, const Normalisation &norm, Progress 
         votes.back() += blocks[b].votes[v];
     }
     for (size_t b = 0; b < blocks.size(); ++b) {
-        progress.poll(0.98);
+        progress.poll(0.9);
         for (uint32_t v : blocks[b].triangles) mesh.triangles.push_back(remap[b][v]);
     }
     return mesh;
@@ -320,12 +320,17 @@ int default_resolution(const Octree &tree) {
 }
 
 Mesh polygonize(const MpuFunction &mpu, const WindingField &winding, const PointSet &points,
-                const PointMeasures &measures, int resolution, const Params &params, Progress &progress) {
+                const PointMeasures &measures, int resolution, const Params &params, Workers &workers,
+                Progress &progress) {
+    // The steps' shares of the stage's progress: the grid and the point buckets, the blocks,
+    // the weld, the cleanup.
+    Progress grid_progress = progress.slice(0.0, 0.02), blocks_progress = progress.slice(0.02, 0.95),
+             weld_progress = progress.slice(0.95, 0.98), cleanup_progress = progress.slice(0.98, 1.0);
     const double h = 1.0 / resolution, min_trust = 2.0 * h;
     // Before allocating anything: the grid alone, then with the band, must fit the budget.
     const double grid_blocks = BlockGrid::blocks_for(points, resolution, std::max(measures.widest_trust, min_trust));
     check_memory(polygonize_memory(grid_blocks, 0, 0), params.max_memory, resolution_text(resolution).c_str());
-    const BlockGrid g(points, resolution, measures.trust_radius, min_trust, winding, progress);
+    const BlockGrid g(points, resolution, measures.trust_radius, min_trust, winding, grid_progress);
     // A band block meets some point's reach, so each of its corners has a point within that
     // reach plus the block's diagonal: the bound for every neighbour search below.
     const double reach = std::max(measures.widest_trust, min_trust) + B * std::sqrt(3.0) * h + h;
@@ -336,15 +341,13 @@ Mesh polygonize(const MpuFunction &mpu, const WindingField &winding, const Point
     const double band_blocks = double(band.size());
     check_memory(polygonize_memory(grid_blocks, band_blocks, band_blocks * kTrianglesPerBandBlock), params.max_memory,
                  resolution_text(resolution).c_str());
-    progress.report(0.02);
-    progress.throw_if_cancelled();
+    grid_progress.poll(1.0);
 
-    const PointBuckets buckets(g, band, f, progress, 0.02);
+    const PointBuckets buckets(g, band, f, grid_progress, 1.0);
     progress.throw_if_cancelled();
     std::vector<BlockOutput> blocks(band.size());
     std::atomic<uint64_t> triangles{0};
-    const double total = double(band.size()) / 0.93;
-    parallel_for(0, band.size(), resolve_threads(params.threads), progress, [&](size_t i) {
+    parallel_for(0, band.size(), workers, blocks_progress, [&](size_t i) {
         polygonize_block(g, f, buckets, band, i, blocks[i]);
         const uint64_t made = blocks[i].triangles.size() / 3;
         const double so_far = double(triangles.fetch_add(made) + made);
@@ -357,13 +360,12 @@ Mesh polygonize(const MpuFunction &mpu, const WindingField &winding, const Point
         // than the band suggested.
         check_memory(polygonize_memory(grid_blocks, band_blocks, so_far), params.max_memory,
                      resolution_text(resolution).c_str());
-    }, 0.02 * total, total, 1);  // one block per chunk: a cancel waits for one block per thread
+    }, 1);  // one block per chunk: a cancel waits for one block per thread
     progress.throw_if_cancelled();
-    progress.report(0.95);
     std::vector<uint32_t> votes;
-    Mesh mesh = weld(blocks, points.normalisation(), progress, votes);
+    Mesh mesh = weld(blocks, points.normalisation(), weld_progress, votes);
     progress.throw_if_cancelled();
-    remove_unsupported_components(mesh, votes, kMinVotes, progress);
+    remove_unsupported_components(mesh, votes, kMinVotes, cleanup_progress);
     return mesh;  // the caller makes the final report, once the temporaries are freed
 }
 

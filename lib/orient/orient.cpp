@@ -18,7 +18,7 @@ void sign_leaves_by_normals(Octree &tree, const PointSet &points, const float *n
     std::vector<float> d2;
     Eigen::Vector3d g;
     for (Cell &c : tree.cells) {
-        progress.poll(0.85 * double(&c - tree.cells.data()) / double(tree.cells.size()));  // O(n) in all
+        progress.poll(double(&c - tree.cells.data()) / double(tree.cells.size()));  // O(n) in all
         if (!c.is_leaf()) continue;
         idx.assign(tree.order.begin() + c.point_begin, tree.order.begin() + c.point_end);
         if (idx.empty()) points.nearest(c.centre, 8, idx, d2);  // a leaf holding no point
@@ -39,7 +39,7 @@ void sign_inner_cells(Octree &tree, const PointSet &points, Progress &progress) 
     constexpr uint32_t kSamplesPerChild = 16;
     Eigen::Vector3d gp, gc;
     for (size_t i = tree.cells.size(); i-- > 0;) {
-        progress.poll(0.9 - 0.05 * double(i) / double(tree.cells.size()));  // ~0.2 s a million points
+        progress.poll(1.0 - double(i) / double(tree.cells.size()));
         Cell &c = tree.cells[i];
         if (c.is_leaf()) continue;
         double vote = 0.0;
@@ -63,42 +63,45 @@ void sign_inner_cells(Octree &tree, const PointSet &points, Progress &progress) 
 
 }  // namespace
 
-OrientStats orient_octree(Octree &tree, const PointSet &points, const float *normals,
-                          const Params &params, Progress &progress, const FrontOptions &front) {
+OrientStats orient_octree(Octree &tree, const PointSet &points, const float *normals, Workers &workers,
+                          Progress &progress, const FrontOptions &front) {
     for (Cell &c : tree.cells) c.sign = 1, c.oriented = false;
     OrientStats stats;
-    const unsigned threads = resolve_threads(params.threads);
+    // The steps' shares of the progress this function is handed.
+    Progress leaves_progress = progress.slice(0.0, 0.9), inner_progress = progress.slice(0.9, 1.0);
     if (normals) {
-        sign_leaves_by_normals(tree, points, normals, progress);
+        sign_leaves_by_normals(tree, points, normals, leaves_progress);
         stats.components = 1;
     } else {
-        LeafGraph graph = build_leaf_graph(tree, threads, progress);
-        progress.report(0.1);
+        Progress graph_progress = leaves_progress.slice(0.0, 0.1), front_progress = leaves_progress.slice(0.1, 0.85),
+                 outward_progress = leaves_progress.slice(0.85, 1.0);
+        LeafGraph graph = build_leaf_graph(tree, workers, graph_progress);
+        graph_progress.report(1.0);
         std::vector<uint32_t> component = connected_components(graph, stats.components);
         std::vector<int8_t> label =
-            propagate_orientation(tree, graph, component, stats.components, front, progress);
+            propagate_orientation(tree, graph, component, stats.components, front, front_progress);
         for (uint32_t v = 0; v < graph.size(); ++v) {
             Cell &c = tree.cells[graph.cell_of[v]];
             c.sign = label[v];
             c.oriented = true;
         }
-        make_components_outward(tree, points, graph, component, stats.components, progress);
+        make_components_outward(tree, points, graph, component, stats.components, outward_progress);
     }
     progress.throw_if_cancelled();
-    sign_inner_cells(tree, points, progress);
+    sign_inner_cells(tree, points, inner_progress);
     for (const Cell &c : tree.cells) stats.flipped_leaves += c.is_leaf() && c.sign < 0;
     return stats;
 }
 
-std::vector<float> point_normals(const MpuFunction &f, const PointSet &points, unsigned threads,
-                                 Progress &progress, double done_before, double total) {
+std::vector<float> point_normals(const MpuFunction &f, const PointSet &points, Workers &workers,
+                                 Progress &progress) {
     const Octree &tree = f.tree();
     std::vector<float> out;
     assign_reporting(out, 3 * points.size(), progress);
     std::vector<uint32_t> leaves;
     for (uint32_t i = 0; i < tree.cells.size(); ++i)
         if (tree.cells[i].is_leaf() && tree.cells[i].point_end > tree.cells[i].point_begin) leaves.push_back(i);
-    parallel_for(0, leaves.size(), threads, progress, [&](size_t l) {
+    parallel_for(0, leaves.size(), workers, progress, [&](size_t l) {
         const Cell &c = tree.cells[leaves[l]];
         // The leaves blending inside this cell, gathered once for all its points.
         thread_local std::vector<uint32_t> near;
@@ -119,7 +122,7 @@ std::vector<float> point_normals(const MpuFunction &f, const PointSet &points, u
             Eigen::Vector3d n = gn > 0.0 ? Eigen::Vector3d(-g / gn) : Eigen::Vector3d::UnitZ();
             for (int d = 0; d < 3; ++d) out[3 * i + d] = float(n[d]);
         }
-    }, done_before, total, 1);  // leaves come coarsest first: one per chunk
+    }, 1);  // leaves come coarsest first: one per chunk
     progress.throw_if_cancelled();
     return out;
 }

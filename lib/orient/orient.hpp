@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/parallel.hpp"
 #include "core/params.hpp"
 #include "core/progress.hpp"
 #include "model/octree.hpp"
@@ -25,12 +26,12 @@ struct OrientStats {
 
 // normals: 3 per point (normalised frame directions) or null. `front` is for measurements
 // only (advancing_front.hpp); the C ABI always passes the defaults.
-OrientStats orient_octree(Octree &tree, const PointSet &points, const float *normals,
-                          const Params &params, Progress &progress, const FrontOptions &front = {});
+OrientStats orient_octree(Octree &tree, const PointSet &points, const float *normals, Workers &workers,
+                          Progress &progress, const FrontOptions &front = {});
 
 // Unit outward normal at every input point: −∇f/|∇f|, or the oriented fit of the point's
 // leaf where ∇f vanishes. 3 floats per point.
-std::vector<float> point_normals(const MpuFunction &f, const PointSet &points, unsigned threads,
-                                 Progress &progress, double done_before, double total);
+std::vector<float> point_normals(const MpuFunction &f, const PointSet &points, Workers &workers,
+                                 Progress &progress);
 
 }  // namespace gmpu

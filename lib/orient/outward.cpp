@@ -6,6 +6,9 @@ namespace gmpu {
 
 namespace {
 
+// Share of this step's progress for the leaves' moments; the nesting test takes the rest.
+constexpr double kMomentsShare = 0.8;
+
 // Oriented surface samples of one leaf, aggregated: Σ A n (the leaf's dipole), the centroid
 // of its points, and its contribution to (1/3)∮ x·n dA.
 struct LeafMoment {
@@ -42,7 +45,7 @@ size_t make_components_outward(Octree &tree, const PointSet &points, const LeafG
     std::vector<LeafMoment> moment(g.size());
     std::vector<double> volume(count, 0.0);
     for (uint32_t v = 0; v < g.size(); ++v) {
-        progress.poll(0.8 + 0.04 * double(v) / double(g.size()));  // every point once: O(n)
+        progress.poll(kMomentsShare * double(v) / double(g.size()));  // every point once: O(n)
         moment[v] = leaf_moment(tree, points, tree.cells[g.cell_of[v]]);
         volume[component[v]] += moment[v].volume;
     }
@@ -67,7 +70,7 @@ size_t make_components_outward(Octree &tree, const PointSet &points, const LeafG
         }
         std::vector<int8_t> parity(count, 1);
         for (uint32_t c = 0; c < count; ++c) {
-            progress.poll(0.84 + 0.01 * double(c) / double(count));  // O(count × leaves) in all
+            progress.poll(kMomentsShare + (1.0 - kMomentsShare) * double(c) / double(count));  // O(count × leaves)
             if (!probe_count[c]) continue;
             const Eigen::Vector3d q = probe[c];
             std::vector<double> winding(count, 0.0);
