@@ -49,7 +49,7 @@ double MpuFunction::blend(const std::vector<uint32_t> &leaves, const Eigen::Vect
         const double d = std::sqrt(d2);
         const double t = 1.5 * d / c.radius;
         const double w = c.blend_factor * bspline(t);
-        const double q = c.value(x, tree_.pieces, gradient ? &g : nullptr);
+        const double q = cell_value(i, x, gradient ? &g : nullptr);
         sw += w;
         swq += w * q;
         if (gradient) {
@@ -59,7 +59,7 @@ double MpuFunction::blend(const std::vector<uint32_t> &leaves, const Eigen::Vect
             dwq_sum += dw * q + w * g;
         }
     }
-    if (!(sw > 0.0)) return tree_.cells[fallback].value(x, tree_.pieces, gradient);
+    if (!(sw > 0.0)) return cell_value(fallback, x, gradient);
     const double f = swq / sw;
     if (gradient) *gradient = (dwq_sum - f * dw_sum) / sw;
     return f;

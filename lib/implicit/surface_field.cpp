@@ -2,16 +2,10 @@
 
 #include <cmath>
 
-#include "core/parallel.hpp"
-#include "core/resize_reporting.hpp"
 
 namespace gmpu {
 
 namespace {
-constexpr size_t kNeighbours = 8;
-// Trust extends this many k-th-neighbour distances from a point: enough to bridge the
-// gaps between samples so the trusted shell around the surface has no holes.
-constexpr double kTrustSpacings = 1.5;
 constexpr size_t kSideVotes = 8;
 // The winding number overrules the side test when it is within this of 0 or 1. Telling
 // 0 from 1 needs less accuracy than the far regions' sign (block_grid.cpp): cells count as
@@ -20,8 +14,6 @@ constexpr size_t kSideVotes = 8;
 constexpr double kDecisiveWinding = 0.25;
 constexpr double kWindingFarRatio = 1.2;
 constexpr double kFarAway = 1e6;  // normalised units: the data spans 1
-// Up to this many points, measure_points searches every point's neighbours.
-constexpr size_t kExactMeasureLimit = 1u << 17;
 }  // namespace
 
 bool SurfaceField::trusted(const Eigen::Vector3d &x) const {
@@ -85,41 +77,6 @@ double SurfaceField::value(const Eigen::Vector3d &x, Eigen::Vector3d *gradient) 
 double SurfaceField::value_among(const std::vector<uint32_t> &leaves, const Eigen::Vector3d &x,
                                  Eigen::Vector3d *gradient) const {
     return trusted(x) ? mpu_.value_among(leaves, x, gradient) : far_value(x, gradient);
-}
-
-void measure_points(const Octree &tree, const PointSet &points, Workers &workers, Progress &progress,
-                    PointMeasures &out) {
-    const size_t n = points.size();
-    assign_reporting(out.area, n, progress);
-    assign_reporting(out.trust_radius, n, progress);
-    auto set = [&](uint32_t i, double rk) {
-        out.area[i] = float(M_PI * rk * rk / double(kNeighbours));
-        out.trust_radius[i] = float(kTrustSpacings * rk);
-    };
-    if (n <= kExactMeasureLimit) {
-        // The k-th neighbour distance of every point: exact, and what sparse or nonuniform
-        // clouds need.
-        parallel_for(0, n, workers, progress, [&](size_t i) {
-            thread_local std::vector<uint32_t> idx;
-            thread_local std::vector<float> d2;
-            points.nearest(points.point(i), kNeighbours + 1, idx, d2);  // includes the point itself
-            set(uint32_t(i), std::sqrt(double(d2.back())));
-        }, 512);
-        progress.throw_if_cancelled();
-    } else {
-        // Dense clouds: the density of each leaf's support, as if the surface crossed its ball
-        // through the centre (π R² of area for its points), gives the k-th neighbour distance
-        // sqrt(k · area per point / π) without a million neighbour searches.
-        for (const Cell &c : tree.cells) {
-            progress.tick();
-            if (!c.is_leaf() || c.point_end == c.point_begin) continue;
-            const double area = M_PI * c.radius * c.radius / double(std::max<uint32_t>(1, c.support_count));
-            const double rk = std::sqrt(double(kNeighbours) * area / M_PI);
-            for (uint32_t k = c.point_begin; k < c.point_end; ++k) set(tree.order[k], rk);
-        }
-    }
-    out.widest_trust = 0.0;
-    for (float r : out.trust_radius) out.widest_trust = std::max(out.widest_trust, double(r));
 }
 
 }  // namespace gmpu

@@ -18,21 +18,12 @@
 
 #include <Eigen/Core>
 
-#include "core/parallel.hpp"
-#include "core/progress.hpp"
 #include "geometry/point_set.hpp"
 #include "implicit/mpu_function.hpp"
+#include "implicit/point_measures.hpp"
 #include "implicit/winding_field.hpp"
 
 namespace gmpu {
-
-// Per-point quantities computed at orient time.
-struct PointMeasures {
-    std::vector<float> normals;       // unit outward, 3 per point
-    std::vector<float> area;          // surface area each point stands for
-    std::vector<float> trust_radius;  // normalised units
-    double widest_trust = 0.0;        // max of trust_radius
-};
 
 class SurfaceField {
 public:
@@ -72,10 +63,5 @@ private:
     const WindingField &winding_;
     double min_trust_, reach_;
 };
-
-// Area and trust radius of every point, from its k-th neighbour distance (normals are
-// filled in separately).
-void measure_points(const Octree &tree, const PointSet &points, Workers &workers, Progress &progress,
-                    PointMeasures &out);
 
 }  // namespace gmpu

@@ -14,7 +14,6 @@
 #include "core/progress.hpp"
 #include "model/octree.hpp"
 #include "geometry/point_set.hpp"
-#include "implicit/mpu_function.hpp"
 #include "orient/advancing_front.hpp"
 
 namespace gmpu {
@@ -24,14 +23,14 @@ struct OrientStats {
     uint32_t flipped_leaves = 0;
 };
 
-// normals: 3 per point (normalised frame directions) or null. `front` is for measurements
-// only (advancing_front.hpp); the C ABI always passes the defaults.
-OrientStats orient_octree(Octree &tree, const PointSet &points, const float *normals, Workers &workers,
-                          Progress &progress, const FrontOptions &front = {});
+struct Orientation {
+    CellSigns signs;  // one per cell of the tree
+    OrientStats stats;
+};
 
-// Unit outward normal at every input point: −∇f/|∇f|, or the oriented fit of the point's
-// leaf where ∇f vanishes. 3 floats per point.
-std::vector<float> point_normals(const MpuFunction &f, const PointSet &points, Workers &workers,
-                                 Progress &progress);
+// The fitted tree's signs. normals: 3 per point (normalised frame directions) or null.
+// `front` is for measurements only (advancing_front.hpp); the C ABI always passes the defaults.
+Orientation orient_octree(const Octree &tree, const PointSet &points, const float *normals, Workers &workers,
+                          Progress &progress, const FrontOptions &front = {});
 
 }  // namespace gmpu

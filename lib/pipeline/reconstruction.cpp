@@ -31,6 +31,7 @@ Workers &Reconstruction::workers(unsigned threads) {
 
 void Reconstruction::discard_fit() {
     tree = Octree();
+    signs.clear();
     measures = PointMeasures();
     winding = WindingField();
     orient_stats = {};
@@ -53,34 +54,32 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
     Workers &pool = workers(params.threads);
     progress.report(0.0, true);
     // The steps' shares of the stage's progress.
-    Progress signs_progress = progress.slice(0.0, 0.9), normals_progress = progress.slice(0.9, 0.95),
-             measures_progress = progress.slice(0.95, 0.95), winding_progress = progress.slice(0.95, 1.0);
-    // Orient only writes the cells' signs and resets them first, so a cancelled or failed
-    // orient leaves a fit that the next orient can use as it is.
+    Progress signs_progress = progress.slice(0.0, 0.9), measures_progress = progress.slice(0.9, 0.95),
+             winding_progress = progress.slice(0.95, 1.0);
+    // The fit is never changed, so a cancelled or failed orient leaves one the next orient
+    // can use as it is.
     winding = WindingField();
-    const OrientStats stats = orient_octree(tree, points, input_normals.empty() ? nullptr : input_normals.data(),
+    Orientation orientation = orient_octree(tree, points, input_normals.empty() ? nullptr : input_normals.data(),
                                             pool, signs_progress);
-    const MpuFunction mpu(tree, 0);
-    PointMeasures new_measures;
-    new_measures.normals = point_normals(mpu, points, pool, normals_progress);
-    measure_points(tree, points, pool, measures_progress, new_measures);
-    measures = std::move(new_measures);
+    const MpuFunction mpu(tree, orientation.signs, 0);
+    measures = measure_points(mpu, points, pool, measures_progress);
     winding = WindingField(tree, points, measures.normals, measures.area, &winding_progress);
     finish(progress);
-    orient_stats = stats;
+    signs = std::move(orientation.signs);
+    orient_stats = orientation.stats;
 }
 
 Mesh Reconstruction::polygonize(const Params &params, int resolution, Progress &progress) {
     Workers &pool = workers(params.threads);
     progress.report(0.0, true);
-    const MpuFunction mpu(tree, params.level);
+    const MpuFunction mpu(tree, signs, params.level);
     Mesh mesh = gmpu::polygonize(mpu, winding, points, measures, resolution, params, pool, progress);
     return mesh;  // the caller checks it and makes the final report
 }
 
 void Reconstruction::evaluate(const Params &params, const double *xyz, size_t count, double *values,
                               double *gradients) const {
-    const MpuFunction mpu(tree, params.level);
+    const MpuFunction mpu(tree, signs, params.level);
     const SurfaceField f(mpu, points, measures, winding);
     const Normalisation &norm = points.normalisation();
     Eigen::Vector3d g;

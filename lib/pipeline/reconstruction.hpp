@@ -29,7 +29,8 @@ struct Reconstruction {
     std::vector<uint32_t> outliers;        // input indices set aside, increasing
     std::vector<uint32_t> outlier_nearest; // per outlier: the nearest kept point
     std::vector<float> input_normals;      // unit, 3 per kept point; empty when none were given
-    Octree tree;                           // fit's result, signed by orient
+    Octree tree;                           // fit's result, never changed after
+    CellSigns signs;                       // orient's result: one label per cell of the tree
     PointMeasures measures;                // orient's: oriented normals, areas, trust radii per point
     WindingField winding;                  // built from the measures; signs far regions
     OrientStats orient_stats;

@@ -18,6 +18,7 @@
 #include "geometry/point_set.hpp"
 #include "gmpu/gmpu.h"
 #include "implicit/mpu_function.hpp"
+#include "implicit/point_measures.hpp"
 #include "orient/orient.hpp"
 
 using namespace gmpu;
@@ -79,12 +80,12 @@ int main(int argc, char **argv) {
             for (const Cell &c : fitted.cells) leaves += c.is_leaf();
             std::printf("%s\t%zu\t%zu", path.substr(path.rfind('/') + 1).c_str(), n, leaves);
             for (const Variant &v : kVariants) {
-                Octree tree = fitted;
+                const Octree &tree = fitted;  // orient leaves the fit as it is
                 FrontOptions front;
                 front.order = v.order;
                 front.decision = v.decision;
-                orient_octree(tree, points, nullptr, workers, quiet, front);
-                const MpuFunction f(tree, 0);
+                const Orientation orientation = orient_octree(tree, points, nullptr, workers, quiet, front);
+                const MpuFunction f(tree, orientation.signs, 0);
                 const std::vector<float> normals = point_normals(f, points, workers, quiet);
                 size_t right = 0;
                 for (size_t i = 0; i < n; ++i) {

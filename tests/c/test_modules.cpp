@@ -291,7 +291,8 @@ void blend_finds_every_covering_leaf(void **) {
                                  tree.cells[size_t(c.parent)].radius)
             ++grown;
     assert_true(grown > 0);  // the case this test is about
-    MpuFunction f(tree, 0);
+    const CellSigns as_fitted;
+    MpuFunction f(tree, as_fitted, 0);
     std::mt19937_64 rng(5);
     std::uniform_real_distribution<double> u(-0.6, 0.6);
     std::vector<uint32_t> near;
