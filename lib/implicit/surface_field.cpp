@@ -74,9 +74,79 @@ double SurfaceField::value(const Eigen::Vector3d &x, Eigen::Vector3d *gradient) 
     return trusted(x) ? mpu_.value(x, gradient) : far_value(x, gradient);
 }
 
-double SurfaceField::value_among(const std::vector<uint32_t> &leaves, const Eigen::Vector3d &x,
-                                 Eigen::Vector3d *gradient) const {
-    return trusted(x) ? mpu_.value_among(leaves, x, gradient) : far_value(x, gradient);
+void SurfaceField::block_values(const LatticeBlock &block, const uint32_t *near, size_t near_count,
+                                const uint8_t *skip, double *values) const {
+    const int n = block.n, C = n + 1, S = kFarStep, CC = n / S + 1;  // coarse lattice step and size
+    auto local = [C](int i, int j, int k) { return size_t(i + C * (j + C * k)); };
+
+    // Trust by splatting every nearby point's ball onto the corners. Ranges are a corner
+    // wider than the ball's box so rounding never decides; the squared-distance test does,
+    // on corner coordinates computed exactly as block.corner() does, the same in every block.
+    thread_local std::vector<uint8_t> trusted;
+    trusted.assign(size_t(C) * C * C, 0);
+    thread_local std::vector<double> axis[3];
+    for (int d = 0; d < 3; ++d) {
+        axis[d].resize(size_t(C));
+        for (int i = 0; i < C; ++i) axis[d][size_t(i)] = block.grid_origin[d] + block.h * double(block.start[d] + i);
+    }
+    for (size_t m = 0; m < near_count; ++m) {
+        const uint32_t p = near[m];
+        const Eigen::Vector3d q = points_.point(p);
+        const double r = trust_radius(p), r2 = r * r;
+        int a[3], b[3];
+        for (int d = 0; d < 3; ++d) {
+            a[d] = std::max(0, int(std::floor((q[d] - r - axis[d][0]) / block.h)));
+            b[d] = std::min(n, int(std::ceil((q[d] + r - axis[d][0]) / block.h)));
+        }
+        for (int k = a[2]; k <= b[2]; ++k) {
+            const double dz = axis[2][size_t(k)] - q[2];
+            for (int j = a[1]; j <= b[1]; ++j) {
+                const double dy = axis[1][size_t(j)] - q[1], dyz = dy * dy + dz * dz;
+                if (dyz > r2) continue;
+                for (int i = a[0]; i <= b[0]; ++i) {
+                    const double dx = axis[0][size_t(i)] - q[0];
+                    if (dx * dx + dyz <= r2) trusted[local(i, j, k)] = 1;
+                }
+            }
+        }
+    }
+
+    thread_local std::vector<double> coarse;
+    thread_local std::vector<uint8_t> coarse_done;
+    coarse.assign(size_t(CC) * CC * CC, 0.0);
+    coarse_done.assign(size_t(CC) * CC * CC, 0);
+    auto far = [&](int i, int j, int k) {
+        const size_t c = size_t(i / S + CC * (j / S + CC * (k / S)));
+        if (!coarse_done[c]) {
+            coarse[c] = far_value(block.corner(i, j, k), nullptr);
+            coarse_done[c] = 1;
+        }
+        return coarse[c];
+    };
+    for (int k = 0; k < C; ++k)
+        for (int j = 0; j < C; ++j)
+            for (int i = 0; i < C; ++i) {
+                const size_t at = local(i, j, k);
+                if (skip && skip[at]) continue;
+                double v;
+                if (trusted[at]) {
+                    v = mpu_.value_among(block.leaves_at(i, j, k), block.corner(i, j, k), nullptr);
+                } else {
+                    // Trilinear in the coarse cell holding the corner.
+                    const int ci = std::min(i / S, CC - 2) * S, cj = std::min(j / S, CC - 2) * S,
+                              ck = std::min(k / S, CC - 2) * S;
+                    const double u = double(i - ci) / S, w = double(j - cj) / S, t = double(k - ck) / S;
+                    v = 0.0;
+                    for (int c = 0; c < 8; ++c) {
+                        const int di = c & 1, dj = c >> 1 & 1, dk = c >> 2 & 1;
+                        const double weight = (di ? u : 1 - u) * (dj ? w : 1 - w) * (dk ? t : 1 - t);
+                        if (weight > 0.0) v += weight * far(ci + S * di, cj + S * dj, ck + S * dk);
+                    }
+                    if (v == 0.0) v = -block.h;  // exactly between: outside, like every tie
+                }
+                if (!std::isfinite(v)) v = -block.h;
+                values[at] = v;
+            }
 }
 
 }  // namespace gmpu

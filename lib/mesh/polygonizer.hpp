@@ -20,8 +20,7 @@ namespace gmpu {
 int default_resolution(const Octree &tree);
 
 // Throws CANCELLED or LIMIT_EXCEEDED (params.max_triangles).
-Mesh polygonize(const MpuFunction &mpu, const WindingField &winding, const PointSet &points,
-                const PointMeasures &measures, int resolution, const Params &params, Workers &workers,
+Mesh polygonize(const SurfaceField &field, int resolution, const Params &params, Workers &workers,
                 Progress &progress);
 
 }  // namespace gmpu

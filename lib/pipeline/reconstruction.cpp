@@ -72,15 +72,13 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
 Mesh Reconstruction::polygonize(const Params &params, int resolution, Progress &progress) {
     Workers &pool = workers(params.threads);
     progress.report(0.0, true);
-    const MpuFunction mpu(tree, signs, params.level);
-    Mesh mesh = gmpu::polygonize(mpu, winding, points, measures, resolution, params, pool, progress);
+    Mesh mesh = gmpu::polygonize(field(params.level), resolution, params, pool, progress);
     return mesh;  // the caller checks it and makes the final report
 }
 
 void Reconstruction::evaluate(const Params &params, const double *xyz, size_t count, double *values,
                               double *gradients) const {
-    const MpuFunction mpu(tree, signs, params.level);
-    const SurfaceField f(mpu, points, measures, winding);
+    const SurfaceField f = field(params.level);
     const Normalisation &norm = points.normalisation();
     Eigen::Vector3d g;
     for (size_t i = 0; i < count; ++i) {

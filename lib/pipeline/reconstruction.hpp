@@ -46,6 +46,13 @@ struct Reconstruction {
     // output may be null. Requires an oriented reconstruction.
     void evaluate(const Params &params, const double *xyz, size_t count, double *values, double *gradients) const;
 
+    // The surface field of the oriented reconstruction, blended down to `level` (0: the
+    // leaves): the one field evaluate and polygonize both ask. A view: valid while this
+    // reconstruction is not changed.
+    SurfaceField field(int level) const {
+        return SurfaceField(MpuFunction(tree, signs, level), points, measures, winding);
+    }
+
     // Forget fit and orient (the points stay).
     void discard_fit();
 
