@@ -227,13 +227,13 @@ struct Builder {
             level.swap(next);
             progress.report(settled);
         }
-        // Subtree reach, children before parents (they come later in the array).
+        // Subtree radius, children before parents (they come later in the array).
         for (size_t i = tree.cells.size(); i-- > 0;) {
             Cell &c = tree.cells[i];
-            c.reach = std::max(c.reach, c.radius);
+            c.subtree_radius = std::max(c.subtree_radius, c.radius);
             if (c.parent >= 0) {
                 Cell &p = tree.cells[size_t(c.parent)];
-                p.reach = std::max(p.reach, (c.centre - p.centre).norm() + c.reach);
+                p.subtree_radius = std::max(p.subtree_radius, (c.centre - p.centre).norm() + c.subtree_radius);
             }
         }
         return std::move(tree);  // the caller makes the final report

@@ -53,9 +53,9 @@ void measure_areas(const Octree &tree, const PointSet &points, Workers &workers,
 
 }  // namespace
 
-std::vector<float> point_normals(const MpuFunction &f, const PointSet &points, Workers &workers,
+std::vector<float> point_normals(const MpuFunction &mpu, const PointSet &points, Workers &workers,
                                  Progress &progress) {
-    const Octree &tree = f.tree();
+    const Octree &tree = mpu.tree();
     std::vector<float> out;
     assign_reporting(out, 3 * points.size(), progress);
     std::vector<uint32_t> leaves;
@@ -67,17 +67,17 @@ std::vector<float> point_normals(const MpuFunction &f, const PointSet &points, W
         // The leaves blending inside this cell, gathered once for all its points.
         thread_local std::vector<uint32_t> near;
         const Eigen::Vector3d half = Eigen::Vector3d::Constant(0.5 * c.size);
-        f.gather(Eigen::AlignedBox3d(c.centre - half, c.centre + half), near);
+        mpu.gather(Eigen::AlignedBox3d(c.centre - half, c.centre + half), near);
         Eigen::Vector3d g;
         for (uint32_t k = c.point_begin; k < c.point_end; ++k) {
             // A coarse leaf can hold thousands of points: report within it too.
             if ((k - c.point_begin) % 16 == 15) progress.tick();
             uint32_t i = tree.order[k];
             Eigen::Vector3d p = points.point(i);
-            f.value_among(near, p, &g);
+            mpu.value_among(near, p, &g);
             double gn = g.norm();
             if (!(gn > 1e-12) || !g.allFinite()) {
-                f.cell_value(cell, p, &g);  // ∇f vanishes: the oriented local fit
+                mpu.cell_value(cell, p, &g);  // ∇f vanishes: the oriented local fit
                 gn = g.norm();
             }
             Eigen::Vector3d n = gn > 0.0 ? Eigen::Vector3d(-g / gn) : Eigen::Vector3d::UnitZ();
@@ -89,12 +89,12 @@ std::vector<float> point_normals(const MpuFunction &f, const PointSet &points, W
 }
 
 
-PointMeasures measure_points(const MpuFunction &f, const PointSet &points, Workers &workers, Progress &progress) {
+PointMeasures measure_points(const MpuFunction &mpu, const PointSet &points, Workers &workers, Progress &progress) {
     PointMeasures out;
-    out.normals = point_normals(f, points, workers, progress);
+    out.normals = point_normals(mpu, points, workers, progress);
     // Areas and trust radii take no share of the bar: they cost little next to the normals.
     Progress areas_progress = progress.slice(1.0, 1.0);
-    measure_areas(f.tree(), points, workers, areas_progress, out);
+    measure_areas(mpu.tree(), points, workers, areas_progress, out);
     return out;
 }
 

@@ -19,12 +19,12 @@ struct PointMeasures {
     double widest_trust = 0.0;        // max of trust_radius
 };
 
-// Every measure of every point, for the oriented blend f.
-PointMeasures measure_points(const MpuFunction &f, const PointSet &points, Workers &workers, Progress &progress);
+// Every measure of every point, for the oriented MPU blend.
+PointMeasures measure_points(const MpuFunction &mpu, const PointSet &points, Workers &workers, Progress &progress);
 
 // Unit outward normal at every input point: −∇f/|∇f|, or the oriented fit of the point's
 // leaf where ∇f vanishes. 3 floats per point.
-std::vector<float> point_normals(const MpuFunction &f, const PointSet &points, Workers &workers,
+std::vector<float> point_normals(const MpuFunction &mpu, const PointSet &points, Workers &workers,
                                  Progress &progress);
 
 }  // namespace gmpu

@@ -59,13 +59,13 @@ public:
 
     // The same field for a polygonizer's grid: `min_trust` widens every trust radius to at
     // least that (two cube sizes, so every cube the surface crosses has its corners
-    // trusted); `reach` bounds the neighbour searches of untrusted queries (the polygonizer
-    // knows every query it makes has a point within its band's reach, and bounded searches
+    // trusted); `search_bound` bounds the neighbour searches of untrusted queries (the polygonizer
+    // knows every query it makes has a point within that distance, and bounded searches
     // are much cheaper far from the data).
-    SurfaceField bounded(double min_trust, double reach) const {
+    SurfaceField bounded(double min_trust, double search_bound) const {
         SurfaceField f = *this;
         f.min_trust_ = min_trust;
-        f.reach_ = reach;
+        f.search_bound_ = search_bound;
         return f;
     }
 
@@ -100,7 +100,7 @@ private:
     const PointSet &points_;
     const PointMeasures &measures_;
     const WindingField &winding_;
-    double min_trust_ = 0.0, reach_ = INFINITY;
+    double min_trust_ = 0.0, search_bound_ = INFINITY;
 };
 
 }  // namespace gmpu

@@ -5,13 +5,13 @@
 #include <cmath>
 #include <string>
 
-#include "core/cancellable_sort.hpp"
 #include "core/memory_budget.hpp"
 #include "core/parallel.hpp"
 #include "mesh/block_grid.hpp"
 #include "mesh/marching_tetrahedra.hpp"
 #include "mesh/mesh_cleanup.hpp"
 #include "mesh/point_buckets.hpp"
+#include "mesh/weld.hpp"
 
 namespace gmpu {
 
@@ -46,13 +46,6 @@ double polygonize_memory(double grid_blocks, double band_blocks, double triangle
 
 std::string resolution_text(int resolution) { return "polygonize at resolution " + std::to_string(resolution); }
 
-struct BlockOutput {
-    std::vector<uint64_t> vertex_key;         // grid edge per vertex: corner id × 8 + direction
-    std::vector<Eigen::Vector3d> vertex_pos;  // normalised frame
-    std::vector<Eigen::Vector3d> vertex_grad;
-    std::vector<uint32_t> triangles;          // block-local vertex indices
-    std::vector<uint32_t> votes;              // per vertex: input points in the block nearest to it
-};
 
 // The leaves blending in each of the block's 2³ sub-blocks (closed boxes of 4³ cubes):
 // shorter lists than one for the whole block, so each value scans fewer candidates.
@@ -169,58 +162,6 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuck
         }
         out.votes[best] += weight[n];
     }
-}
-
-// One vertex per grid edge across blocks: sort every block's vertices by edge key.
-// `votes` receives the point votes per welded vertex.
-Mesh weld(std::vector<BlockOutput> &blocks, const Normalisation &norm, Progress &progress,
-          std::vector<uint32_t> &votes) {
-    // Every big array is reserved up front: growing one by doubling copies tens of
-    // megabytes in one go, with no progress report in between.
-    size_t vertex_slots = 0, triangle_slots = 0;
-    for (const BlockOutput &block : blocks) vertex_slots += block.vertex_key.size(), triangle_slots += block.triangles.size();
-    std::vector<std::pair<uint64_t, uint64_t>> keyed;  // (edge key, block << 32 | local index)
-    keyed.reserve(vertex_slots);
-    for (size_t b = 0; b < blocks.size(); ++b) {
-        progress.poll(0.0);
-        for (size_t v = 0; v < blocks[b].vertex_key.size(); ++v) keyed.push_back({blocks[b].vertex_key[v], uint64_t(b) << 32 | v});
-    }
-    cancellable_sort(keyed, progress, 0.3);
-
-    size_t welded = 0;
-    for (size_t k = 0; k < keyed.size(); ++k) {
-        if (k % 65536 == 0) progress.poll(0.6);
-        welded += k == 0 || keyed[k].first != keyed[k - 1].first;
-    }
-    Mesh mesh;
-    mesh.vertices.reserve(3 * welded);
-    mesh.normals.reserve(3 * welded);
-    mesh.triangles.reserve(triangle_slots);
-    votes.reserve(welded);
-    std::vector<std::vector<uint32_t>> remap(blocks.size());
-    for (size_t b = 0; b < blocks.size(); ++b) {
-        progress.poll(0.6);
-        remap[b].resize(blocks[b].vertex_key.size());
-    }
-    for (size_t k = 0; k < keyed.size(); ++k) {
-        if (k % 4096 == 0) progress.poll(0.7);
-        const size_t b = keyed[k].second >> 32, v = keyed[k].second & 0xffffffffu;
-        if (k == 0 || keyed[k].first != keyed[k - 1].first) {
-            const Eigen::Vector3d p = norm.to_world(blocks[b].vertex_pos[v]);
-            Eigen::Vector3d n = -blocks[b].vertex_grad[v].normalized();  // f grows inward
-            if (!n.allFinite()) n = Eigen::Vector3d::UnitZ();
-            mesh.vertices.insert(mesh.vertices.end(), {p[0], p[1], p[2]});
-            mesh.normals.insert(mesh.normals.end(), {n[0], n[1], n[2]});
-            votes.push_back(0);
-        }
-        remap[b][v] = uint32_t(mesh.vertex_count() - 1);
-        votes.back() += blocks[b].votes[v];
-    }
-    for (size_t b = 0; b < blocks.size(); ++b) {
-        progress.poll(0.9);
-        for (uint32_t v : blocks[b].triangles) mesh.triangles.push_back(remap[b][v]);
-    }
-    return mesh;
 }
 
 }  // namespace

@@ -23,7 +23,7 @@ struct Cell {
     double radius = 0.0;   // support radius R (after growing to hold N_min points)
     // Radius around the centre that holds the support ball of this cell and of every cell
     // below it: a grown child's ball can reach beyond its parent's, so searches prune on this.
-    double reach = 0.0;
+    double subtree_radius = 0.0;
     uint16_t coord[3] = {0, 0, 0};  // integer position among the cells of its depth
     uint8_t depth = 0;
     uint8_t child_mask = 0;          // which of the 8 octants have a child
