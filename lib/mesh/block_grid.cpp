@@ -6,10 +6,10 @@
 namespace gmpu {
 
 namespace {
-// Spare blocks beyond the widest reach keep the band off the grid's edge, so the region
-// touching the edge surrounds everything. Two, not one: mark_band widens its boxes a hair,
-// so with one a point at the box's edge marked block 0, the band reached the grid's edge
-// and a surface crossing it was left open (fuzz_pipeline found it with garbage normals).
+// Spare blocks beyond the widest trust radius keep the band off the grid's edge, so the
+// region touching the edge surrounds everything. Two, not one: mark_band widens its boxes
+// a hair, so with one a point at the box's edge can mark block 0, and the band would reach
+// the grid's edge, leaving open a surface that crosses it.
 double grid_pad(double widest, double h) { return widest + 2 * BlockGrid::B * h; }
 }  // namespace
 
