@@ -1,5 +1,5 @@
-// Orient stage: gives every cell's local function its sign, so that the blend is one
-// consistent field, positive inside. Without input normals: leaf graph → belief
+// Orient stage: a sign for every cell's local function (kept beside the fitted tree, which
+// it does not change), so that the blend is one consistent field, positive inside. Without input normals: leaf graph → belief
 // propagation advanced as a front per component → each component made outward. With
 // input normals: each leaf takes the sign its points' normals vote for. Either way the
 // inner cells (used by the level-of-detail cap and far-field fallback) then follow their
