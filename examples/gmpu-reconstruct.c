@@ -24,11 +24,23 @@
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 
 #include "cli/staged_output.h"
 #include "gmpu/gmpu.h"
 
 #define MAX_PARAMS 64
+
+/* Between stages, hand the heap's free pages back to the system: glibc keeps what a stage's
+ * threads freed in their arenas, so the next stage (and this program's peak) would stack on
+ * top of it. The library leaves the host's heap alone; this program is the host. */
+static void release_free_memory(void) {
+#ifdef __GLIBC__
+    malloc_trim(0);
+#endif
+}
 
 typedef struct {
     const char *input, *output, *normals_out;
@@ -451,8 +463,11 @@ int main(int argc, char **argv) {
         }
     }
     if (gmpu_surface_fit(surface) != GMPU_OK) { rc = fail("fit failed"); goto done; }
+    release_free_memory();
     if (gmpu_surface_orient(surface) != GMPU_OK) { rc = fail("orient failed"); goto done; }
+    release_free_memory();
     if (gmpu_surface_polygonize(surface, &mesh) != GMPU_OK) { rc = fail("polygonize failed"); goto done; }
+    release_free_memory();
     if (!finish_mesh(&o, &mesh)) goto done;
     double t_write = now_seconds();
     mesh_vertices = gmpu_mesh_vertex_count(mesh);

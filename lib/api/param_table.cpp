@@ -11,7 +11,7 @@
 
 #include "api/guard.hpp"
 #include "core/error.hpp"
-#include "geometry/octree.hpp"
+#include "model/octree.hpp"
 
 namespace gmpu::api {
 namespace {

@@ -3,7 +3,7 @@
 
 #include <cstddef>
 
-#include "geometry/octree.hpp"
+#include "model/octree.hpp"
 #include "geometry/point_set.hpp"
 #include "gmpu/gmpu.h"
 #include "orient/orient.hpp"

@@ -1,13 +1,10 @@
 // The C ABI of gmpu_surface: a state machine over the pipeline's stages
 // (points → fitted → oriented), each verb checking that the stage before it is done.
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <memory>
 #include <string>
-#include <system_error>
-#include <thread>
 #include <utility>
 
 #include "api/guard.hpp"
@@ -16,49 +13,34 @@
 #include "api/param_table.hpp"
 #include "api/statistics.hpp"
 #include "api/surface_parts.hpp"
-#include "core/parallel.hpp"
 #include "core/params.hpp"
 #include "core/progress.hpp"
-#include "core/release_memory.hpp"
-#include "fit/build_octree.hpp"
-#include "fit/noise_estimate.hpp"
 #include "geometry/clusters.hpp"
 #include "geometry/outliers.hpp"
 #include "geometry/point_set.hpp"
-#include "implicit/mpu_function.hpp"
-#include "implicit/surface_field.hpp"
-#include "implicit/winding_field.hpp"
 #include "mesh/confidence.hpp"
 #include "mesh/polygonizer.hpp"
-#include "orient/orient.hpp"
 #include "orient/orient_memory.hpp"
+#include "pipeline/reconstruction.hpp"
 
 using gmpu::Error;
 using gmpu::api::guarded;
 using gmpu::api::require_arg;
 
-struct gmpu_surface {
+// The handle is the reconstruction (lib/pipeline) plus what the ABI keeps around it: the
+// parameters, the stage reached, the progress callback, the last error and the timings.
+struct gmpu_surface : gmpu::Reconstruction {
     enum class Stage { empty, points, fitted, oriented };
     Stage stage = Stage::empty;
     gmpu::Params params;
-    gmpu::PointSet points;             // the input points less the outliers
-    size_t input_count = 0;            // points given to set_points, outliers included
-    std::vector<uint32_t> outliers;        // input indices set aside, increasing
-    std::vector<uint32_t> outlier_nearest; // per outlier: the nearest kept point
-    std::vector<float> input_normals;  // unit, 3 per point; empty when none were given
-    gmpu::Octree tree;
-    gmpu::PointMeasures measures;      // oriented normals, areas, trust radii per point
-    gmpu::WindingField winding;        // built from the measures; signs far regions
     // Set when the points are spatially separated clusters: then each is a surface of its
-    // own, and points, tree, measures and winding above stay empty.
+    // own, and the reconstruction's points, tree, measures and winding stay empty.
     std::unique_ptr<gmpu::api::SurfaceParts> parts;
     gmpu_progress_fn progress_fn = nullptr;
     void *progress_user = nullptr;
     std::string last_error;
-    gmpu::OrientStats orient_stats;
     double seconds[4] = {0, 0, 0, 0};  // by gmpu_stage
     int last_resolution = 0;
-    double noise = 0.0, epsilon = 0.0;  // of the last fit, normalised units
     // The stage running on this surface (0 when none). Its progress callback may call back
     // into gmpu; a call on this same surface would free or rebuild what the stage is using,
     // so every such call is refused with BUSY, and destroy is deferred to the stage's end.
@@ -67,10 +49,7 @@ struct gmpu_surface {
 
     void discard_fit() {
         if (stage > Stage::points) stage = Stage::points;
-        tree = gmpu::Octree();
-        measures = gmpu::PointMeasures();
-        winding = gmpu::WindingField();
-        orient_stats = {};
+        gmpu::Reconstruction::discard_fit();
     }
     void require_idle(const char *verb) const {
         static const char *const names[] = {"", "gmpu_surface_fit", "gmpu_surface_orient", "gmpu_surface_polygonize"};
@@ -90,11 +69,7 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
-// A long stage (fit, orient, polygonize) behind the exception firewall. Whether it succeeds
-// or fails, its temporaries are freed by the time it returns: hand them back to the OS. A
-// successful stage did so itself before its final report (finish_stage); a failed one does
-// here, except a cancelled one, which the caller wants back at once (the next stage or
-// destroy hands the memory back).
+// A long stage (fit, orient, polygonize) behind the exception firewall.
 template <class Body>
 gmpu_status run_stage(gmpu_surface *s, gmpu_stage stage, const char *verb, Body &&body) noexcept {
     if (s && s->running_stage != 0)  // re-entered from the running stage's callback
@@ -107,7 +82,6 @@ gmpu_status run_stage(gmpu_surface *s, gmpu_stage stage, const char *verb, Body 
         // just completed, and its mesh is the caller's); the surface goes now.
         if (s->destroy_when_idle) delete s;
     }
-    if (status != GMPU_OK && status != GMPU_ERROR_CANCELLED) gmpu::release_free_memory();
     return status;
 }
 
@@ -117,30 +91,6 @@ int progress_or_stop(void *surface, gmpu_stage stage, double fraction) {
     if (s->destroy_when_idle) return 1;
     const int answer = s->progress_fn ? s->progress_fn(s->progress_user, stage, fraction) : 0;
     return s->destroy_when_idle ? 1 : answer;
-}
-
-// The end of a successful stage, before it commits its result. The temporaries are freed by
-// now; handing their memory back to the OS can take tens of milliseconds of CPU, so it runs
-// on a helper thread while this one keeps reporting (the callback's cadence is the calling
-// thread's promise). Then the final report (fraction 1), after which nothing slow follows; a
-// cancel on it counts.
-void finish_stage(gmpu::Progress &progress) {
-    std::atomic<bool> trimmed{false};
-    try {
-        std::thread trimmer([&] {
-            gmpu::release_free_memory();
-            trimmed = true;
-        });
-        while (!trimmed) {
-            std::this_thread::sleep_for(std::chrono::milliseconds(2));
-            progress.report(0.0);  // repeats the last fraction
-        }
-        trimmer.join();
-    } catch (const std::system_error &) {  // no thread to spare: trim here
-        gmpu::release_free_memory();
-    }
-    progress.report(1.0, true);
-    progress.throw_if_cancelled();
 }
 
 // The clusters' surfaces take every parameter of their owner's.
@@ -225,7 +175,6 @@ GMPU_API void gmpu_surface_destroy(gmpu_surface *s) {
         return;
     }
     delete s;
-    gmpu::release_free_memory();
 }
 
 GMPU_API const char *gmpu_surface_last_error(const gmpu_surface *s) { return s ? s->last_error.c_str() : ""; }
@@ -302,10 +251,10 @@ GMPU_API gmpu_status gmpu_surface_fit(gmpu_surface *s) {
         s->require(gmpu_surface::Stage::points, "gmpu_surface_fit", "gmpu_surface_set_points");
         auto t0 = Clock::now();
         gmpu::Progress progress(s->progress_fn ? progress_or_stop : nullptr, s, GMPU_STAGE_FIT);
-        progress.report(0.0, true);
         if (s->parts) {
             // Each cluster's fit replaces its own as it goes: until all are done, the
             // clusters do not share one fit, so a failed or cancelled fit leaves none.
+            progress.report(0.0, true);
             s->discard_fit();
             push_params(s->params, *s->parts);
             s->parts->fit(progress_or_stop, s);
@@ -315,14 +264,7 @@ GMPU_API gmpu_status gmpu_surface_fit(gmpu_surface *s) {
             s->seconds[GMPU_STAGE_FIT] = since(t0);
             return;
         }
-        const double noise = gmpu::estimate_noise(s->points, progress);
-        const double epsilon = gmpu::effective_epsilon(s->points, s->params, noise);
-        gmpu::Octree tree = gmpu::build_octree(s->points, s->params, epsilon, progress);
-        finish_stage(progress);
-        s->discard_fit();
-        s->tree = std::move(tree);
-        s->noise = noise;
-        s->epsilon = epsilon;
+        s->fit(s->params, progress);
         s->stage = gmpu_surface::Stage::fitted;
         s->seconds[GMPU_STAGE_FIT] = since(t0);
     });
@@ -334,11 +276,9 @@ GMPU_API gmpu_status gmpu_surface_orient(gmpu_surface *s) {
         s->require(gmpu_surface::Stage::fitted, "gmpu_surface_orient", "gmpu_surface_fit");
         auto t0 = Clock::now();
         gmpu::Progress progress(s->progress_fn ? progress_or_stop : nullptr, s, GMPU_STAGE_ORIENT);
-        progress.report(0.0, true);
-        // Orient only writes the cells' signs and resets them first, so a cancelled or failed
-        // orient leaves a fit that the next orient can use as it is.
-        s->stage = gmpu_surface::Stage::fitted;
+        s->stage = gmpu_surface::Stage::fitted;  // until this orient completes
         if (s->parts) {
+            progress.report(0.0, true);
             push_params(s->params, *s->parts);
             s->parts->orient(progress_or_stop, s);
             progress.report(1.0, true);
@@ -347,22 +287,8 @@ GMPU_API gmpu_status gmpu_surface_orient(gmpu_surface *s) {
             s->seconds[GMPU_STAGE_ORIENT] = since(t0);
             return;
         }
-        s->winding = gmpu::WindingField();
         gmpu::check_orient_memory(s->tree, s->points, s->params.max_memory);
-        gmpu::Octree &tree = s->tree;
-        gmpu::OrientStats stats = gmpu::orient_octree(
-            tree, s->points, s->input_normals.empty() ? nullptr : s->input_normals.data(), s->params, progress);
-        gmpu::MpuFunction f(tree, 0);
-        const unsigned threads = gmpu::resolve_threads(s->params.threads);
-        gmpu::PointMeasures measures;
-        measures.normals = gmpu::point_normals(f, s->points, threads, progress,
-                                               0.9 * double(s->points.size()) / 0.05,
-                                               double(s->points.size()) / 0.05);
-        gmpu::measure_points(tree, s->points, threads, progress, measures);
-        s->measures = std::move(measures);
-        s->winding = gmpu::WindingField(tree, s->points, s->measures.normals, s->measures.area, &progress);
-        finish_stage(progress);
-        s->orient_stats = stats;
+        s->orient(s->params, progress);
         s->stage = gmpu_surface::Stage::oriented;
         s->seconds[GMPU_STAGE_ORIENT] = since(t0);
     });
@@ -383,20 +309,7 @@ GMPU_API gmpu_status gmpu_surface_evaluate(const gmpu_surface *s, const double *
             if (!std::isfinite(xyz[i]))
                 throw Error(GMPU_ERROR_INVALID_INPUT, "query point " + std::to_string(i / 3) + " is NaN or infinite");
         if (s->parts) return s->parts->evaluate(xyz, count, values, gradients);
-        const gmpu::MpuFunction mpu(s->tree, s->params.level);
-        const gmpu::SurfaceField f(mpu, s->points, s->measures, s->winding);
-        const gmpu::Normalisation &norm = s->points.normalisation();
-        Eigen::Vector3d g;
-        for (size_t i = 0; i < count; ++i) {
-            Eigen::Vector3d q = norm.to_unit(Eigen::Vector3d(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]));
-            // A finite query can normalise to inf (1e300 against a cloud at 1e-30), and f and
-            // ∇f would be inf and NaN. Beyond 1e15 box lengths f is the far value anyway.
-            q = q.cwiseMax(-1e15).cwiseMin(1e15);
-            double v = f.value(q, gradients ? &g : nullptr);
-            if (values) values[i] = v / norm.scale;
-            if (gradients)
-                for (int d = 0; d < 3; ++d) gradients[3 * i + d] = g[d];
-        }
+        s->evaluate(s->params, xyz, count, values, gradients);
     });
 }
 
@@ -448,16 +361,19 @@ GMPU_API gmpu_status gmpu_surface_polygonize(gmpu_surface *s, gmpu_mesh **out) {
             return;
         }
         int resolution = s->params.resolution > 0 ? s->params.resolution : gmpu::default_resolution(s->tree);
-        const gmpu::MpuFunction mpu(s->tree, s->params.level);
+        // The steps' shares of the stage's progress.
+        gmpu::Progress mesh_progress = progress.slice(0.0, 0.95), confidence_progress = progress.slice(0.95, 1.0);
         auto mesh = std::make_unique<gmpu_mesh>();
-        mesh->mesh = gmpu::polygonize(mpu, s->winding, s->points, s->measures, resolution, s->params, progress);
+        mesh->mesh = s->polygonize(s->params, resolution, mesh_progress);
         if (mesh->mesh.triangle_count() == 0)
             throw Error(GMPU_ERROR_DEGENERATE_INPUT,
                         "polygonize found no closed surface at resolution " + std::to_string(resolution) +
                             " (no piece of the zero set is near enough input points): the points may be "
                             "too few or too sparse for a solid, or the grid too coarse for them");
-        gmpu::compute_confidence(mesh->mesh, s->points, s->measures, s->params.threads, progress);
-        finish_stage(progress);
+        gmpu::compute_confidence(mesh->mesh, s->points, s->measures, s->workers(s->params.threads),
+                                confidence_progress);
+        progress.report(1.0, true);  // the final report; a cancel on it counts
+        progress.throw_if_cancelled();
         s->last_resolution = resolution;
         s->seconds[GMPU_STAGE_POLYGONIZE] = since(t0);
         *out = mesh.release();

@@ -1,12 +1,8 @@
 #include "core/parallel.hpp"
 
 #include <algorithm>
-#include <chrono>
 #include <atomic>
-#include <exception>
-#include <mutex>
-#include <thread>
-#include <vector>
+#include <chrono>
 
 namespace gmpu {
 
@@ -16,14 +12,51 @@ unsigned resolve_threads(unsigned requested) {
     return hw > 0 ? hw : 1;
 }
 
-void parallel_for(size_t begin, size_t end, unsigned threads, Progress &progress,
-                  const std::function<void(size_t)> &body, double done_before, double total,
-                  size_t chunk) {
+Workers::Workers(unsigned threads) : requested_(resolve_threads(threads)) {
+    helpers_.reserve(requested_ - 1);
+    for (unsigned t = 1; t < requested_; ++t) {
+        try {
+            helpers_.emplace_back([this] { helper_loop(); });
+        } catch (...) {
+            // The system refused a thread (a pids or process limit, no memory for a stack):
+            // the threads already running and the caller share the work instead.
+            break;
+        }
+    }
+}
+
+Workers::~Workers() {
+    {
+        std::lock_guard<std::mutex> lock(m_);
+        stop_ = true;
+    }
+    wake_.notify_all();
+    for (auto &t : helpers_) t.join();
+}
+
+void Workers::helper_loop() {
+    unsigned long seen = 0;
+    std::unique_lock<std::mutex> lock(m_);
+    for (;;) {
+        wake_.wait(lock, [&] { return stop_ || (job_ && generation_ != seen); });
+        if (stop_) return;
+        seen = generation_;
+        const std::function<void()> *job = job_;
+        ++running_;
+        lock.unlock();
+        (*job)();
+        lock.lock();
+        if (--running_ == 0) idle_.notify_all();
+    }
+}
+
+void parallel_for(size_t begin, size_t end, Workers &workers, Progress &progress,
+                  const std::function<void(size_t)> &body, size_t chunk) {
     if (begin >= end) return;
     chunk = std::max<size_t>(1, chunk);
+    const double count = double(end - begin);
     std::atomic<size_t> next{begin};
     std::atomic<size_t> finished{0};
-    std::atomic<unsigned> active{0};
     std::exception_ptr failure;
     std::mutex failure_mutex;
 
@@ -42,38 +75,34 @@ void parallel_for(size_t begin, size_t end, unsigned threads, Progress &progress
                 return;
             }
             size_t done = finished.fetch_add(stop - start) + (stop - start);
-            // A loop without a share of the bar (total 0) still reports, repeating the last
-            // fraction, so that the callback keeps its 50 ms cadence and can cancel the loop.
-            if (is_caller) progress.report(total > 0 ? (done_before + double(done)) / total : 0.0);
+            if (is_caller) progress.report(double(done) / count);
         }
     };
 
-    unsigned n = std::max(1u, std::min<unsigned>(threads, unsigned((end - begin + chunk - 1) / chunk)));
-    std::vector<std::thread> pool;
-    pool.reserve(n - 1);
-    for (unsigned t = 1; t < n; ++t) {
-        active.fetch_add(1);
-        try {
-            pool.emplace_back([&] {
-                work(false);
-                active.fetch_sub(1);
-            });
-        } catch (...) {
-            // The system refused a thread (a pids or process limit, no memory for a stack):
-            // the threads already running and the caller share the work instead. Letting the
-            // exception out here would destroy joinable threads, which terminates.
-            active.fetch_sub(1);
-            break;
+    std::unique_lock<std::mutex> busy(workers.busy_, std::try_to_lock);
+    const bool shared = busy.owns_lock() && !workers.helpers_.empty() && end - begin > chunk;
+    const std::function<void()> helper_work = [&] { work(false); };
+    if (shared) {
+        {
+            std::lock_guard<std::mutex> lock(workers.m_);
+            workers.job_ = &helper_work;
+            ++workers.generation_;
         }
+        workers.wake_.notify_all();
     }
     work(true);
-    // The caller keeps reporting (and so keeps cancellation responsive) while the last
-    // chunks finish on the other threads.
-    while (active.load() > 0) {
-        std::this_thread::sleep_for(std::chrono::milliseconds(5));
-        progress.report(total > 0 ? (done_before + double(finished.load())) / total : 0.0);
+    if (shared) {
+        // No helper may start the job from here on; then the caller keeps reporting (and so
+        // keeps cancellation responsive) while the helpers inside it finish their chunks.
+        std::unique_lock<std::mutex> lock(workers.m_);
+        workers.job_ = nullptr;
+        while (workers.running_ > 0) {
+            workers.idle_.wait_for(lock, std::chrono::milliseconds(5));
+            lock.unlock();
+            progress.report(double(finished.load()) / count);
+            lock.lock();
+        }
     }
-    for (auto &t : pool) t.join();
     if (failure) std::rethrow_exception(failure);
 }
 

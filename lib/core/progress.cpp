@@ -16,20 +16,21 @@ const char *stage_name(gmpu_stage stage) {
 }
 }  // namespace
 
-void Progress::report(double fraction, bool force) {
-    if (!fn_ || cancelled()) return;
+void Progress::report_overall(double fraction, bool force) {
+    Shared &s = *shared_;
+    if (!s.fn || cancelled()) return;
     auto now = std::chrono::steady_clock::now();
-    if (!force && now - last_report_ < kReportInterval) return;
-    last_report_ = now;
+    if (!force && now - s.last_report < kReportInterval) return;
+    s.last_report = now;
     // Promise the caller a non-decreasing fraction in [0, 1].
-    last_fraction_ = std::clamp(std::max(fraction, last_fraction_), 0.0, 1.0);
-    if (fn_(user_, stage_, last_fraction_) != 0) cancel();
+    s.last_fraction = std::clamp(std::max(fraction, s.last_fraction), 0.0, 1.0);
+    if (s.fn(s.user, s.stage, s.last_fraction) != 0) cancel();
 }
 
 void Progress::throw_if_cancelled() const {
     if (cancelled())
         throw Error(GMPU_ERROR_CANCELLED,
-                    std::string(stage_name(stage_)) + " cancelled by the progress callback");
+                    std::string(stage_name(shared_->stage)) + " cancelled by the progress callback");
 }
 
 

@@ -25,15 +25,21 @@ constexpr auto kMaxCancelLatency = std::chrono::milliseconds(100);
 
 class Progress {
 public:
-    Progress(gmpu_progress_fn fn, void *user, gmpu_stage stage)
-        : fn_(fn), user_(user), stage_(stage), caller_(std::this_thread::get_id()) {}
+    Progress(gmpu_progress_fn fn, void *user, gmpu_stage stage) : own_{fn, user, stage, std::this_thread::get_id()} {}
+    // A slice is a view of the same progress (one callback, one cancel flag) whose fractions
+    // 0..1 land on [lo, hi] of this one's: a stage hands each of its steps a slice, and a
+    // step reports 0..1 without knowing where it sits in the stage. Slices must not outlive
+    // the progress they were cut from.
+    Progress(const Progress &) = delete;
+    Progress &operator=(const Progress &) = delete;
+    Progress slice(double lo, double hi) const { return Progress(*shared_, at(lo), at(hi)); }
 
     // Calling thread only. Reports `fraction` if enough time has passed since the last report
     // (always when force is set) and records a cancellation request.
-    void report(double fraction, bool force = false);
+    void report(double fraction, bool force = false) { report_overall(at(fraction), force); }
 
-    bool cancelled() const { return cancelled_.load(std::memory_order_relaxed); }
-    void cancel() { cancelled_.store(true, std::memory_order_relaxed); }
+    bool cancelled() const { return shared_->cancelled.load(std::memory_order_relaxed); }
+    void cancel() { shared_->cancelled.store(true, std::memory_order_relaxed); }
 
     // Throws CANCELLED if the callback asked to stop.
     void throw_if_cancelled() const;
@@ -50,20 +56,29 @@ public:
     // block): on the calling thread it reports the last fraction again (throttled); on
     // every thread it throws CANCELLED once cancelled, which parallel_for carries back.
     void tick() {
-        if (std::this_thread::get_id() == caller_) report(last_fraction_);
+        if (std::this_thread::get_id() == shared_->caller) report_overall(shared_->last_fraction, false);
         throw_if_cancelled();
     }
 
-    gmpu_stage stage() const { return stage_; }
+    gmpu_stage stage() const { return shared_->stage; }
 
 private:
-    gmpu_progress_fn fn_;
-    void *user_;
-    gmpu_stage stage_;
-    std::thread::id caller_;
-    double last_fraction_ = 0.0;
-    std::atomic<bool> cancelled_{false};
-    std::chrono::steady_clock::time_point last_report_{};
+    struct Shared {
+        gmpu_progress_fn fn;
+        void *user;
+        gmpu_stage stage;
+        std::thread::id caller;
+        double last_fraction = 0.0;
+        std::atomic<bool> cancelled{false};
+        std::chrono::steady_clock::time_point last_report{};
+    };
+    Progress(Shared &shared, double lo, double hi) : shared_(&shared), lo_(lo), hi_(hi) {}
+    double at(double fraction) const { return lo_ + fraction * (hi_ - lo_); }
+    void report_overall(double fraction, bool force);
+
+    Shared own_{};
+    Shared *shared_ = &own_;
+    double lo_ = 0.0, hi_ = 1.0;  // this slice of the stage's bar
 };
 
 }  // namespace gmpu

@@ -40,6 +40,7 @@ struct Builder {
     const Params &params;
     double epsilon;  // ε in normalised units
     double requested;  // the caller's ε, before the noise floor
+    Workers &workers;
     Progress &progress;
     Octree tree;
 
@@ -179,7 +180,6 @@ struct Builder {
         fit(root, true, root_piece);
         append(std::move(root), root_piece);
 
-        const unsigned threads = resolve_threads(params.threads);
         std::vector<uint32_t> level;
         if (should_subdivide(tree.cells[0])) level.push_back(0);
         double settled = level.empty() ? 1.0 : 0.0;  // share of points already in leaves
@@ -187,19 +187,19 @@ struct Builder {
         while (!level.empty()) {
             std::vector<std::vector<Child>> kids(level.size());
             // Map this level onto the unsettled part of the progress bar.
-            double span = std::max(1e-9, (1.0 - settled) * 0.5);
-            double total = double(level.size()) / span;
+            const double span = std::max(1e-9, (1.0 - settled) * 0.5);
+            Progress level_progress = progress.slice(settled, settled + span);
             // The cap is checked as children are made, not once the level is done: a level can
             // hold most of the octree, and would otherwise overshoot the cap up to 8-fold.
             std::atomic<size_t> made{tree.cells.size()};
             // One cell per chunk: near the root a cell's fit takes tens of milliseconds, and
             // the caller reports progress (and sees a cancel) only between chunks.
-            parallel_for(0, level.size(), threads, progress, [&](size_t i) {
+            parallel_for(0, level.size(), workers, level_progress, [&](size_t i) {
                 kids[i] = make_children(tree.cells[level[i]]);
                 const double cells = double(made += kids[i].size());
                 if (cells > params.max_cells) too_many_cells();
                 check_fit_memory(n, cells, params.max_memory);
-            }, settled * total, total, 1);
+            }, 1);
             progress.throw_if_cancelled();
 
             std::vector<uint32_t> next;
@@ -227,13 +227,13 @@ struct Builder {
             level.swap(next);
             progress.report(settled);
         }
-        // Subtree reach, children before parents (they come later in the array).
+        // Subtree radius, children before parents (they come later in the array).
         for (size_t i = tree.cells.size(); i-- > 0;) {
             Cell &c = tree.cells[i];
-            c.reach = std::max(c.reach, c.radius);
+            c.subtree_radius = std::max(c.subtree_radius, c.radius);
             if (c.parent >= 0) {
                 Cell &p = tree.cells[size_t(c.parent)];
-                p.reach = std::max(p.reach, (c.centre - p.centre).norm() + c.reach);
+                p.subtree_radius = std::max(p.subtree_radius, (c.centre - p.centre).norm() + c.subtree_radius);
             }
         }
         return std::move(tree);  // the caller makes the final report
@@ -252,8 +252,9 @@ double effective_epsilon(const PointSet &points, const Params &params, double no
     return std::max(requested_epsilon(points, params), params.noise_scale * noise);
 }
 
-Octree build_octree(const PointSet &points, const Params &params, double epsilon, Progress &progress) {
-    Builder b{points, params, epsilon, std::min(epsilon, requested_epsilon(points, params)), progress, {}};
+Octree build_octree(const PointSet &points, const Params &params, double epsilon, Workers &workers,
+                    Progress &progress) {
+    Builder b{points, params, epsilon, std::min(epsilon, requested_epsilon(points, params)), workers, progress, {}};
     return b.run();
 }
 

@@ -8,8 +8,9 @@
 #pragma once
 
 #include "core/params.hpp"
+#include "core/parallel.hpp"
 #include "core/progress.hpp"
-#include "geometry/octree.hpp"
+#include "model/octree.hpp"
 #include "geometry/point_set.hpp"
 
 namespace gmpu {
@@ -19,6 +20,7 @@ namespace gmpu {
 double effective_epsilon(const PointSet &points, const Params &params, double noise);
 
 // Throws CANCELLED or LIMIT_EXCEEDED (GMPU_PARAM_MAX_CELLS). epsilon in normalised units.
-Octree build_octree(const PointSet &points, const Params &params, double epsilon, Progress &progress);
+Octree build_octree(const PointSet &points, const Params &params, double epsilon, Workers &workers,
+                    Progress &progress);
 
 }  // namespace gmpu

@@ -8,7 +8,7 @@
 
 #include <Eigen/Core>
 
-#include "fit/local_shape.hpp"
+#include "model/local_shape.hpp"
 
 namespace gmpu {
 

@@ -20,8 +20,8 @@ uint32_t MpuFunction::collect(const Eigen::Vector3d &x, std::vector<uint32_t> &o
         const uint32_t i = stack[--top];
         const Cell &c = tree_.cells[i];
         // A subtree may hold covering leaves even where its root's own ball does not reach
-        // (grown supports), so the walk prunes on the subtree's reach.
-        if ((x - c.centre).squaredNorm() >= c.reach * c.reach) continue;
+        // (grown supports), so the walk prunes on the subtree's radius.
+        if ((x - c.centre).squaredNorm() >= c.subtree_radius * c.subtree_radius) continue;
         const bool own = covers(c, x);
         if (own && c.depth >= tree_.cells[deepest].depth) deepest = i;
         if (is_leaf(c)) {
@@ -49,7 +49,7 @@ double MpuFunction::blend(const std::vector<uint32_t> &leaves, const Eigen::Vect
         const double d = std::sqrt(d2);
         const double t = 1.5 * d / c.radius;
         const double w = c.blend_factor * bspline(t);
-        const double q = c.value(x, tree_.pieces, gradient ? &g : nullptr);
+        const double q = cell_value(i, x, gradient ? &g : nullptr);
         sw += w;
         swq += w * q;
         if (gradient) {
@@ -59,7 +59,7 @@ double MpuFunction::blend(const std::vector<uint32_t> &leaves, const Eigen::Vect
             dwq_sum += dw * q + w * g;
         }
     }
-    if (!(sw > 0.0)) return tree_.cells[fallback].value(x, tree_.pieces, gradient);
+    if (!(sw > 0.0)) return cell_value(fallback, x, gradient);
     const double f = swq / sw;
     if (gradient) *gradient = (dwq_sum - f * dw_sum) / sw;
     return f;
@@ -84,7 +84,7 @@ void MpuFunction::gather(const Eigen::AlignedBox3d &box, std::vector<uint32_t> &
         stack.pop_back();
         const Cell &c = tree_.cells[i];
         const double d2 = box.squaredExteriorDistance(c.centre);
-        if (d2 >= c.reach * c.reach) continue;
+        if (d2 >= c.subtree_radius * c.subtree_radius) continue;
         if (is_leaf(c)) {
             if (d2 < c.radius * c.radius) leaves.push_back(i);
             continue;

@@ -23,7 +23,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "geometry/octree.hpp"
+#include "model/octree.hpp"
 
 namespace gmpu {
 
@@ -34,7 +34,9 @@ constexpr double kCoarseFitTolerance = 0.07;
 
 class MpuFunction {
 public:
-    MpuFunction(const Octree &tree, int level_cap) : tree_(tree), cap_(level_cap > 0 ? level_cap : 255) {}
+    // `signs`: orient's labels (empty: every cell as fitted). Both are kept by reference.
+    MpuFunction(const Octree &tree, const CellSigns &signs, int level_cap)
+        : tree_(tree), signs_(signs), cap_(level_cap > 0 ? level_cap : 255) {}
 
     // f and (optionally) ∇f at x, in the normalised frame.
     double value(const Eigen::Vector3d &x, Eigen::Vector3d *gradient) const;
@@ -51,6 +53,11 @@ public:
                        Eigen::Vector3d *gradient) const;
 
     const Octree &tree() const { return tree_; }
+    int8_t sign(uint32_t cell) const { return signs_.empty() ? int8_t(1) : signs_[cell]; }
+    // ℓ_i Q_i(x) of one cell.
+    double cell_value(uint32_t cell, const Eigen::Vector3d &x, Eigen::Vector3d *gradient) const {
+        return oriented_value(tree_.cells[cell], sign(cell), x, tree_.pieces, gradient);
+    }
 
 private:
     bool is_leaf(const Cell &c) const {
@@ -64,6 +71,7 @@ private:
     double blend(const std::vector<uint32_t> &sorted_leaves, const Eigen::Vector3d &x,
                  Eigen::Vector3d *gradient, uint32_t fallback) const;
     const Octree &tree_;
+    const CellSigns &signs_;
     int cap_;
 };
 

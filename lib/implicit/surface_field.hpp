@@ -13,44 +13,74 @@
 // surface can appear away from the data.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "geometry/point_set.hpp"
 #include "implicit/mpu_function.hpp"
+#include "implicit/point_measures.hpp"
 #include "implicit/winding_field.hpp"
 
 namespace gmpu {
 
-// Per-point quantities computed at orient time.
-struct PointMeasures {
-    std::vector<float> normals;       // unit outward, 3 per point
-    std::vector<float> area;          // surface area each point stands for
-    std::vector<float> trust_radius;  // normalised units
-    double widest_trust = 0.0;        // max of trust_radius
+// A cubic block of lattice corners for one batch of queries: corner (i, j, k), 0 <= i, j, k
+// <= n, sits at grid_origin + h · (start + (i, j, k)) (the same arithmetic for every block,
+// so blocks sharing a corner agree bit for bit). `leaves` are the MPU leaves gathered for
+// each octant sub-block of n/2 cubes a side (MpuFunction::gather), octant bit 0: +x.
+struct LatticeBlock {
+    Eigen::Vector3d grid_origin;
+    double h = 0.0;
+    int64_t start[3] = {0, 0, 0};
+    int n = 0;
+    const std::vector<uint32_t> *leaves[8] = {};
+
+    Eigen::Vector3d corner(int i, int j, int k) const {
+        return grid_origin + h * Eigen::Vector3d(double(start[0] + i), double(start[1] + j), double(start[2] + k));
+    }
+    // The leaves for a corner (0..n per axis) or a cube (0..n-1): a sub-block whose box holds it.
+    const std::vector<uint32_t> &leaves_at(int i, int j, int k) const {
+        const int half = n / 2;
+        return *leaves[std::min(i / half, 1) | std::min(j / half, 1) << 1 | std::min(k / half, 1) << 2];
+    }
 };
 
 class SurfaceField {
 public:
-    // `min_trust` widens every trust radius to at least that (the polygonizer passes two
-    // cube sizes, so every cube the surface crosses has its corners trusted). `reach`
-    // bounds the neighbour searches of untrusted queries (infinite for general use; the
-    // polygonizer knows every query it makes has a point within its band's reach, and
-    // bounded searches are much cheaper far from the data).
     // `winding` (built from the same measures) signs the far field where it is decisive
-    // (see far_value); an empty one leaves it to the side test.
+    // (see far_value); an empty one leaves it to the side test. All are kept by reference
+    // except the blend, a small view.
     SurfaceField(const MpuFunction &mpu, const PointSet &points, const PointMeasures &measures,
-                 const WindingField &winding, double min_trust = 0.0, double reach = INFINITY)
-        : mpu_(mpu), points_(points), measures_(measures), winding_(winding), min_trust_(min_trust), reach_(reach) {}
+                 const WindingField &winding)
+        : mpu_(mpu), points_(points), measures_(measures), winding_(winding) {}
+
+    // The same field for a polygonizer's grid: `min_trust` widens every trust radius to at
+    // least that (two cube sizes, so every cube the surface crosses has its corners
+    // trusted); `search_bound` bounds the neighbour searches of untrusted queries (the polygonizer
+    // knows every query it makes has a point within that distance, and bounded searches
+    // are much cheaper far from the data).
+    SurfaceField bounded(double min_trust, double search_bound) const {
+        SurfaceField f = *this;
+        f.min_trust_ = min_trust;
+        f.search_bound_ = search_bound;
+        return f;
+    }
 
     // f and optionally ∇f at x (normalised frame).
     double value(const Eigen::Vector3d &x, Eigen::Vector3d *gradient) const;
 
-    // value() for x inside the box `leaves` was gathered for (MpuFunction::gather).
-    double value_among(const std::vector<uint32_t> &leaves, const Eigen::Vector3d &x,
-                       Eigen::Vector3d *gradient) const;
+    // f at every corner of `block` whose skip flag is 0 (skip may be null), into
+    // values[i + (n+1)(j + (n+1) k)]. Trust comes from the `near` points only: every point
+    // whose (widened) trust ball may reach the block. Untrusted corners take the far field
+    // sampled on the coarse lattice of every kFarStep-th corner and interpolated: its sign
+    // only matters away from the data, where it varies slowly, and this costs 1/64 of the
+    // neighbour searches.
+    static constexpr int kFarStep = 4;
+    void block_values(const LatticeBlock &block, const uint32_t *near, size_t near_count, const uint8_t *skip,
+                      double *values) const;
 
     // Whether x lies within some point's trust radius (widened to min_trust).
     bool trusted(const Eigen::Vector3d &x) const;
@@ -62,18 +92,15 @@ public:
 
     const MpuFunction &mpu() const { return mpu_; }
     const PointSet &points() const { return points_; }
+    const PointMeasures &measures() const { return measures_; }
+    const WindingField &winding() const { return winding_; }
 
 private:
-    const MpuFunction &mpu_;
+    MpuFunction mpu_;
     const PointSet &points_;
     const PointMeasures &measures_;
     const WindingField &winding_;
-    double min_trust_, reach_;
+    double min_trust_ = 0.0, search_bound_ = INFINITY;
 };
-
-// Area and trust radius of every point, from its k-th neighbour distance (normals are
-// filled in separately).
-void measure_points(const Octree &tree, const PointSet &points, unsigned threads, class Progress &progress,
-                    PointMeasures &out);
 
 }  // namespace gmpu

@@ -14,7 +14,7 @@ WindingField::WindingField(const Octree &tree, const PointSet &points, const std
     // Children follow parents, so a reverse sweep could aggregate; a direct pass over each
     // cell's contiguous point range is as simple and costs O(n · depth).
     for (size_t c = 0; c < tree.cells.size(); ++c) {
-        if (progress) progress->poll(0.95 + 0.05 * double(c) / double(tree.cells.size()));
+        if (progress) progress->poll(double(c) / double(tree.cells.size()));
         const Cell &cell = tree.cells[c];
         Moment &m = moments_[c];
         double total = 0.0;

@@ -10,7 +10,7 @@
 #include <Eigen/Core>
 
 #include "core/progress.hpp"
-#include "geometry/octree.hpp"
+#include "model/octree.hpp"
 #include "geometry/point_set.hpp"
 
 namespace gmpu {

@@ -1,5 +1,6 @@
-// The public entry points of io.hpp: pick the format from the extension, open the file
-// (a regular file, or an IO error), parse it, check the values; or validate, write through AtomicFile and commit.
+// The public entry points of io.hpp: pick the format's row (kFormats) from the extension,
+// open the file (a regular file, or an IO error), parse it, check the values; or validate,
+// write through AtomicFile and commit. A new format is one row plus its reader and writer.
 #include <algorithm>
 #include <cctype>
 #include <climits>
@@ -20,40 +21,6 @@ namespace gmpu::io {
 namespace detail {
 
 namespace {
-
-enum class Format { ply, xyz, off, obj };
-
-// What each entry point accepts, for lookup and for the error message.
-struct Accepts {
-    const char *purpose;
-    const char *list;  // for the message
-    bool ply, xyz, off, obj;
-};
-constexpr Accepts reading_points{"reading points", ".ply, .xyz, .txt, .off, .obj", true, true, true, true};
-constexpr Accepts reading_meshes{"reading meshes", ".ply, .off, .obj", true, false, true, true};
-constexpr Accepts writing_meshes{"writing meshes", ".ply, .obj, .off", true, false, true, true};
-constexpr Accepts writing_points{"writing points", ".ply, .xyz", true, true, false, false};
-
-// Lower-cased extension of the file name (without the dot), "" when it has none.
-std::string extension(const std::string &path) {
-    const size_t slash = path.find_last_of('/');
-    const size_t dot = path.find_last_of('.');
-    if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
-    std::string ext = path.substr(dot + 1);
-    for (char &c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-    return ext;
-}
-
-Format format_of(const std::string &path, const Accepts &a) {
-    const std::string ext = extension(path);
-    if (a.ply && ext == "ply") return Format::ply;
-    if (a.xyz && (ext == "xyz" || (ext == "txt" && &a == &reading_points))) return Format::xyz;
-    if (a.off && ext == "off") return Format::off;
-    if (a.obj && ext == "obj") return Format::obj;
-    fail(GMPU_ERROR_UNSUPPORTED, path,
-         (ext.empty() ? std::string("no file extension") : "unsupported extension '." + ext + "'") + " for " +
-             a.purpose + " (expected " + a.list + ")");
-}
 
 // What reading `points` points takes at most, on top of `held` bytes of the file in memory:
 // positions and normals as doubles. Over the budget: LIMIT_EXCEEDED, before the arrays or
@@ -104,32 +71,113 @@ std::string read_ply_bytes(InputFile &file, const std::string &path, double budg
 
 // Progress: the bytes read, then parsed, each pass a share of the whole (the values' check
 // after it takes the last tenth).
-Parsed parse(Format f, InputFile &file, const std::string &path, Want want, const ReadOptions &options,
-             ReadTicker &ticker) {
-    const double budget = options.max_memory > 0.0 ? options.max_memory : default_memory_budget();
+Parsed read_ply(InputFile &file, const std::string &path, Want want, double budget, ReadTicker &ticker) {
     file.set_ticker(&ticker);
-    if (f == Format::ply) {
-        ticker.pass(0.0, 0.45);
-        const std::string bytes = read_ply_bytes(file, path, budget);
-        file.set_ticker(nullptr);
-        ticker.pass(0.45, 0.45);
-        return parse_ply_buffer(bytes.data(), bytes.size(), path, want, &ticker);
-    }
-    // Text formats: read in chunks, the arrays sized once from a count of the lines, so a
-    // text file costs the memory of its numbers, not of its bytes as well. The count (an
-    // upper bound on the points) is checked against the budget before the parse.
+    ticker.pass(0.0, 0.45);
+    const std::string bytes = read_ply_bytes(file, path, budget);
+    file.set_ticker(nullptr);
+    ticker.pass(0.45, 0.45);
+    return parse_ply_buffer(bytes.data(), bytes.size(), path, want, &ticker);
+}
+
+// Text formats: read in chunks, the arrays sized once from a count of the lines, so a text
+// file costs the memory of its numbers, not of its bytes as well. The count (an upper bound
+// on the points) is checked against the budget before the parse.
+uint64_t count_text_lines(InputFile &file, const std::string &path, double budget, ReadTicker &ticker) {
+    file.set_ticker(&ticker);
     ticker.pass(0.0, 0.2);
     const uint64_t line_count = count_lines(file, path);
     check_read_memory(path, line_count, double(kLineBufferBytes), budget);
     ticker.pass(0.2, 0.7);
+    return line_count;
+}
+Parsed read_xyz(InputFile &file, const std::string &path, Want, double budget, ReadTicker &ticker) {
+    const uint64_t line_count = count_text_lines(file, path, budget, ticker);
     LineReader lines(file, path);
-    switch (f) {
-        case Format::xyz: return parse_xyz_lines(lines, path, line_count);
-        case Format::off: return parse_off_lines(lines, path, want);
-        case Format::obj: return parse_obj_lines(lines, path, want, line_count);
-        case Format::ply: break;
+    return parse_xyz_lines(lines, path, line_count);
+}
+Parsed read_off(InputFile &file, const std::string &path, Want want, double budget, ReadTicker &ticker) {
+    count_text_lines(file, path, budget, ticker);
+    LineReader lines(file, path);
+    return parse_off_lines(lines, path, want);
+}
+Parsed read_obj(InputFile &file, const std::string &path, Want want, double budget, ReadTicker &ticker) {
+    const uint64_t line_count = count_text_lines(file, path, budget, ticker);
+    LineReader lines(file, path);
+    return parse_obj_lines(lines, path, want, line_count);
+}
+
+void write_ply_mesh(AtomicFile &out, const MeshView &mesh) { write_ply(out, mesh, true); }
+void write_ply_points(AtomicFile &out, const double *xyz, const double *normals, size_t count) {
+    MeshView view;
+    view.vertices = xyz;
+    view.vertex_count = count;
+    view.normals = normals;
+    write_ply(out, view, false);
+}
+
+// One row per format: its extensions and what reads and writes it (null: not supported).
+struct FormatRow {
+    const char *extension;       // lower case, without the dot
+    const char *read_extension;  // another name accepted when reading points, or null
+    Parsed (*read_points)(InputFile &, const std::string &, Want, double budget, ReadTicker &);
+    Parsed (*read_mesh)(InputFile &, const std::string &, Want, double budget, ReadTicker &);
+    void (*write_mesh)(AtomicFile &, const MeshView &);
+    void (*write_points)(AtomicFile &, const double *, const double *, size_t);
+};
+constexpr FormatRow kFormats[] = {
+    {"ply", nullptr, read_ply, read_ply, write_ply_mesh, write_ply_points},
+    {"obj", nullptr, read_obj, read_obj, write_obj, nullptr},
+    {"off", nullptr, read_off, read_off, write_off, nullptr},
+    {"xyz", "txt", read_xyz, nullptr, nullptr, write_xyz},
+};
+
+// The roles a format can play, for lookup and for the error message.
+enum class Role { read_points, read_mesh, write_mesh, write_points };
+
+bool plays(const FormatRow &row, Role role) {
+    switch (role) {
+        case Role::read_points: return row.read_points != nullptr;
+        case Role::read_mesh: return row.read_mesh != nullptr;
+        case Role::write_mesh: return row.write_mesh != nullptr;
+        case Role::write_points: return row.write_points != nullptr;
     }
-    fail(GMPU_ERROR_INTERNAL, path, "unknown format");
+    return false;
+}
+
+const char *purpose(Role role) {
+    switch (role) {
+        case Role::read_points: return "reading points";
+        case Role::read_mesh: return "reading meshes";
+        case Role::write_mesh: return "writing meshes";
+        case Role::write_points: return "writing points";
+    }
+    return "";
+}
+
+// Lower-cased extension of the file name (without the dot), "" when it has none.
+std::string extension(const std::string &path) {
+    const size_t slash = path.find_last_of('/');
+    const size_t dot = path.find_last_of('.');
+    if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) return "";
+    std::string ext = path.substr(dot + 1);
+    for (char &c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    return ext;
+}
+
+const FormatRow &format_of(const std::string &path, Role role) {
+    const std::string ext = extension(path);
+    std::string list;
+    for (const FormatRow &row : kFormats) {
+        if (!plays(row, role)) continue;
+        const bool reads_alias = role == Role::read_points && row.read_extension;
+        if (ext == row.extension || (reads_alias && ext == row.read_extension)) return row;
+        list += std::string(list.empty() ? "." : ", .") + row.extension;
+        if (reads_alias) list += std::string(", .") + row.read_extension;
+    }
+    fail(GMPU_ERROR_UNSUPPORTED, path,
+         (ext.empty() ? std::string("no file extension") : "unsupported extension '." + ext + "'") + " for " +
+             purpose(role) + " (expected " + list + ")");
 }
 
 void check_finite(const std::vector<double> &v, const std::string &name, const char *what,
@@ -161,10 +209,11 @@ void check_mesh(const Parsed &parsed, const std::string &name) {
 using detail::fail;
 
 PointCloud read_points(const std::string &path, const ReadOptions &options) {
-    const detail::Format f = detail::format_of(path, detail::reading_points);
+    const detail::FormatRow &format = detail::format_of(path, detail::Role::read_points);
     detail::InputFile file(path);
     detail::ReadTicker ticker{options.progress};
-    detail::Parsed parsed = detail::parse(f, file, path, detail::Want::points, options, ticker);
+    const double budget = options.max_memory > 0.0 ? options.max_memory : default_memory_budget();
+    detail::Parsed parsed = format.read_points(file, path, detail::Want::points, budget, ticker);
     ticker.pass(0.9, 0.1);
     detail::check_points(parsed, path, &ticker);
     PointCloud cloud;
@@ -174,10 +223,10 @@ PointCloud read_points(const std::string &path, const ReadOptions &options) {
 }
 
 MeshData read_mesh(const std::string &path) {
-    const detail::Format f = detail::format_of(path, detail::reading_meshes);
+    const detail::FormatRow &format = detail::format_of(path, detail::Role::read_mesh);
     detail::InputFile file(path);
     detail::ReadTicker ticker;
-    detail::Parsed parsed = detail::parse(f, file, path, detail::Want::mesh, ReadOptions{}, ticker);
+    detail::Parsed parsed = format.read_mesh(file, path, detail::Want::mesh, default_memory_budget(), ticker);
     detail::check_mesh(parsed, path);
     MeshData mesh;
     mesh.vertices = std::move(parsed.positions);
@@ -201,7 +250,7 @@ void check_arrays(const std::string &path, const double *xyz, const double *norm
 }  // namespace
 
 void write_mesh(const std::string &path, const MeshView &mesh) {
-    const detail::Format f = detail::format_of(path, detail::writing_meshes);
+    const detail::FormatRow &format = detail::format_of(path, detail::Role::write_mesh);
     check_arrays(path, mesh.vertices, mesh.normals, mesh.vertex_count);
     if (mesh.triangle_count > 0 && !mesh.triangles)
         fail(GMPU_ERROR_INVALID_ARGUMENT, path, "triangle array is NULL");
@@ -214,28 +263,15 @@ void write_mesh(const std::string &path, const MeshView &mesh) {
                                                      std::to_string(mesh.triangles[i]) + " of " +
                                                      std::to_string(mesh.vertex_count));
     AtomicFile out(path);
-    switch (f) {
-        case detail::Format::ply: detail::write_ply(out, mesh, true); break;
-        case detail::Format::obj: detail::write_obj(out, mesh); break;
-        case detail::Format::off: detail::write_off(out, mesh); break;
-        case detail::Format::xyz: break;  // not accepted for meshes
-    }
+    format.write_mesh(out, mesh);
     out.commit();
 }
 
 void write_points(const std::string &path, const double *xyz, const double *normals, size_t count) {
-    const detail::Format f = detail::format_of(path, detail::writing_points);
+    const detail::FormatRow &format = detail::format_of(path, detail::Role::write_points);
     check_arrays(path, xyz, normals, count);
     AtomicFile out(path);
-    if (f == detail::Format::ply) {
-        MeshView view;
-        view.vertices = xyz;
-        view.vertex_count = count;
-        view.normals = normals;
-        detail::write_ply(out, view, false);
-    } else {
-        detail::write_xyz(out, xyz, normals, count);
-    }
+    format.write_points(out, xyz, normals, count);
     out.commit();
 }
 

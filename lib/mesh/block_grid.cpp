@@ -6,10 +6,10 @@
 namespace gmpu {
 
 namespace {
-// Spare blocks beyond the widest reach keep the band off the grid's edge, so the region
-// touching the edge surrounds everything. Two, not one: mark_band widens its boxes a hair,
-// so with one a point at the box's edge marked block 0, the band reached the grid's edge
-// and a surface crossing it was left open (fuzz_pipeline found it with garbage normals).
+// Spare blocks beyond the widest trust radius keep the band off the grid's edge, so the
+// region touching the edge surrounds everything. Two, not one: mark_band widens its boxes
+// a hair, so with one a point at the box's edge can mark block 0, and the band would reach
+// the grid's edge, leaving open a surface that crosses it.
 double grid_pad(double widest, double h) { return widest + 2 * BlockGrid::B * h; }
 }  // namespace
 
@@ -21,11 +21,11 @@ double BlockGrid::blocks_for(const PointSet &points, int resolution, double wide
     return blocks;
 }
 
-BlockGrid::BlockGrid(const PointSet &points, int resolution, const std::vector<float> &reach, double min_reach,
+BlockGrid::BlockGrid(const PointSet &points, int resolution, const std::vector<float> &trust_radius, double min_trust,
                      const WindingField &winding, Progress &progress) {
     h = 1.0 / resolution;  // the longest side of the normalised box is 1
-    double widest = min_reach;
-    for (float r : reach) widest = std::max(widest, double(r));
+    double widest = min_trust;
+    for (float r : trust_radius) widest = std::max(widest, double(r));
     const double pad = grid_pad(widest, h);
     origin = points.box_min() - Eigen::Vector3d::Constant(pad);
     for (int d = 0; d < 3; ++d) {
@@ -33,7 +33,7 @@ BlockGrid::BlockGrid(const PointSet &points, int resolution, const std::vector<f
         blocks[d] = std::max<int64_t>(1, int64_t(std::ceil(extent / (h * B))));
         cubes[d] = blocks[d] * B;
     }
-    mark_band(points, reach, min_reach, progress);
+    mark_band(points, trust_radius, min_trust, progress);
     sign_far_regions(winding, progress);
 }
 
@@ -44,13 +44,13 @@ Eigen::AlignedBox3d BlockGrid::block_box(int64_t id) const {
     return Eigen::AlignedBox3d(lo, lo + Eigen::Vector3d::Constant(B * h));
 }
 
-void BlockGrid::mark_band(const PointSet &points, const std::vector<float> &reach, double min_reach,
+void BlockGrid::mark_band(const PointSet &points, const std::vector<float> &trust_radius, double min_trust,
                           Progress &progress) {
     band.assign(size_t(blocks[0] * blocks[1] * blocks[2]), 0);
     const double block = B * h;
     for (size_t i = 0; i < points.size(); ++i) {
         if (i % 4096 == 0) progress.tick();  // O(n) on the calling thread
-        const double r = std::max(double(reach[i]), min_reach);
+        const double r = std::max(double(trust_radius[i]), min_trust);
         const Eigen::Vector3d p = points.point(i) - origin;
         int64_t lo[3], hi[3];
         for (int d = 0; d < 3; ++d) {

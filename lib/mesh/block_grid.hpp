@@ -28,11 +28,11 @@ struct BlockGrid {
     std::vector<uint8_t> band;      // per block
     std::vector<int8_t> far_sign;   // per block: 0 in the band, else its region's sign
 
-    // `reach[i]`: how far from point i the band must extend (its trust radius).
-    BlockGrid(const PointSet &points, int resolution, const std::vector<float> &reach, double min_reach,
+    // `trust_radius[i]`: how far from point i the band must extend (at least min_trust).
+    BlockGrid(const PointSet &points, int resolution, const std::vector<float> &trust_radius, double min_trust,
               const WindingField &winding, Progress &progress);
 
-    // Blocks of the grid the constructor would make, with `widest` the largest reach: known
+    // Blocks of the grid the constructor would make, with `widest` the largest trust radius: known
     // before the grid is allocated, for the memory estimate.
     static double blocks_for(const PointSet &points, int resolution, double widest);
 
@@ -59,7 +59,7 @@ struct BlockGrid {
     size_t block_count() const { return band.size(); }
 
 private:
-    void mark_band(const PointSet &points, const std::vector<float> &reach, double min_reach, Progress &progress);
+    void mark_band(const PointSet &points, const std::vector<float> &trust_radius, double min_trust, Progress &progress);
     void sign_far_regions(const WindingField &winding, Progress &progress);
 };
 

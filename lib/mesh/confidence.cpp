@@ -7,7 +7,7 @@
 
 namespace gmpu {
 
-void compute_confidence(Mesh &mesh, const PointSet &points, const PointMeasures &measures, unsigned threads,
+void compute_confidence(Mesh &mesh, const PointSet &points, const PointMeasures &measures, Workers &workers,
                         Progress &progress) {
     const size_t n = mesh.vertex_count();
     mesh.confidence.assign(n, 0.0);
@@ -15,7 +15,7 @@ void compute_confidence(Mesh &mesh, const PointSet &points, const PointMeasures 
     const Normalisation &norm = points.normalisation();
     constexpr size_t kChunk = 256;
     const size_t chunks = (n + kChunk - 1) / kChunk;
-    parallel_for(0, chunks, resolve_threads(threads), progress, [&](size_t c) {
+    parallel_for(0, chunks, workers, progress, [&](size_t c) {
         std::vector<uint32_t> nearest;
         std::vector<float> squared;
         for (size_t v = c * kChunk; v < std::min(n, (c + 1) * kChunk); ++v) {

@@ -4,6 +4,7 @@
 // on such a cap.
 #pragma once
 
+#include "core/parallel.hpp"
 #include "core/progress.hpp"
 #include "geometry/point_set.hpp"
 #include "implicit/surface_field.hpp"
@@ -14,7 +15,7 @@ namespace gmpu {
 // Per vertex: distance to the nearest input point divided by that point's sample spacing
 // (the square root of the area it stands for). About 0.5 or less on sampled surface;
 // several where the surface bridges a hole. Fills mesh.confidence.
-void compute_confidence(Mesh &mesh, const PointSet &points, const PointMeasures &measures, unsigned threads,
+void compute_confidence(Mesh &mesh, const PointSet &points, const PointMeasures &measures, Workers &workers,
                         Progress &progress);
 
 // Removes every triangle with a vertex whose confidence is above `threshold`, and the

@@ -5,13 +5,13 @@
 #include <cmath>
 #include <string>
 
-#include "core/cancellable_sort.hpp"
 #include "core/memory_budget.hpp"
 #include "core/parallel.hpp"
 #include "mesh/block_grid.hpp"
 #include "mesh/marching_tetrahedra.hpp"
 #include "mesh/mesh_cleanup.hpp"
 #include "mesh/point_buckets.hpp"
+#include "mesh/weld.hpp"
 
 namespace gmpu {
 
@@ -46,25 +46,11 @@ double polygonize_memory(double grid_blocks, double band_blocks, double triangle
 
 std::string resolution_text(int resolution) { return "polygonize at resolution " + std::to_string(resolution); }
 
-struct BlockOutput {
-    std::vector<uint64_t> vertex_key;         // grid edge per vertex: corner id × 8 + direction
-    std::vector<Eigen::Vector3d> vertex_pos;  // normalised frame
-    std::vector<Eigen::Vector3d> vertex_grad;
-    std::vector<uint32_t> triangles;          // block-local vertex indices
-    std::vector<uint32_t> votes;              // per vertex: input points in the block nearest to it
-};
 
-// Values at the (B+1)³ corners of one band block. Each corner's value depends on its
-// position alone (never on the block), so neighbouring blocks agree on shared corners:
-//  - touching a far block: that region's sign;
-//  - within some point's trust radius: the MPU blend;
-//  - otherwise: the far field (a signed distance by the nearby normals), sampled on the
-//    coarse lattice of every fourth corner and interpolated — its sign only matters away
-//    from the data, where it varies slowly, and this costs 1/64 of the neighbour searches.
 // The leaves blending in each of the block's 2³ sub-blocks (closed boxes of 4³ cubes):
 // shorter lists than one for the whole block, so each value scans fewer candidates.
 struct SubBlockLeaves {
-    static constexpr int S = B / 2;
+    static constexpr int kHalf = B / 2;  // cubes along a sub-block's side
     std::vector<uint32_t> list[8];
     void gather(const MpuFunction &mpu, const BlockGrid &g, const int64_t origin[3]) {
         // A hair wider than each sub-block, so a vertex rounded just past its face still
@@ -73,99 +59,23 @@ struct SubBlockLeaves {
         // One octree walk for the whole block; each sub-block filters its list.
         thread_local std::vector<uint32_t> block;
         const Eigen::Vector3d origin_corner = g.corner(origin[0], origin[1], origin[2]);
-        mpu.gather(Eigen::AlignedBox3d(origin_corner - pad, origin_corner + Eigen::Vector3d::Constant(2 * S * g.h) + pad),
+        mpu.gather(Eigen::AlignedBox3d(origin_corner - pad, origin_corner + Eigen::Vector3d::Constant(2 * kHalf * g.h) + pad),
                    block);
         for (int s = 0; s < 8; ++s) {
-            const Eigen::Vector3d lo = g.corner(origin[0] + S * (s & 1), origin[1] + S * (s >> 1 & 1), origin[2] + S * (s >> 2 & 1));
-            mpu.gather_among(block, Eigen::AlignedBox3d(lo - pad, lo + Eigen::Vector3d::Constant(S * g.h) + pad), list[s]);
+            const Eigen::Vector3d lo = g.corner(origin[0] + kHalf * (s & 1), origin[1] + kHalf * (s >> 1 & 1),
+                                                origin[2] + kHalf * (s >> 2 & 1));
+            mpu.gather_among(block, Eigen::AlignedBox3d(lo - pad, lo + Eigen::Vector3d::Constant(kHalf * g.h) + pad), list[s]);
         }
-    }
-    // For a corner (0..B per axis) or a cube (0..B-1): a sub-block whose box holds it.
-    const std::vector<uint32_t> &at(int i, int j, int k) const {
-        return list[std::min(i / S, 1) | std::min(j / S, 1) << 1 | std::min(k / S, 1) << 2];
     }
 };
-
-void corner_values(const BlockGrid &g, const SurfaceField &f, const SubBlockLeaves &leaves,
-                   const uint32_t *near, size_t near_count, const int64_t origin[3], std::vector<double> &value) {
-    constexpr int C = B + 1, S = 4, CC = B / S + 1;  // coarse lattice step and size
-    const bool touches_far = g.touches_far(g.block_id(origin[0] / B, origin[1] / B, origin[2] / B));
-    auto local = [](int i, int j, int k) { return i + C * (j + C * k); };
-
-    // Trust by splatting every nearby point's ball onto the corners. Ranges are a corner
-    // wider than the ball's box so rounding never decides; the squared-distance test does,
-    // on corner coordinates computed exactly as g.corner() does, the same in every block.
-    thread_local std::vector<uint8_t> trusted(C * C * C);
-    std::fill(trusted.begin(), trusted.end(), 0);
-    double axis[3][C];
-    for (int d = 0; d < 3; ++d)
-        for (int i = 0; i < C; ++i) axis[d][i] = g.origin[d] + g.h * double(origin[d] + i);
-    for (size_t n = 0; n < near_count; ++n) {
-        const uint32_t p = near[n];
-        const Eigen::Vector3d q = f.points().point(p);
-        const double r = f.trust_radius(p), r2 = r * r;
-        int a[3], b[3];
-        for (int d = 0; d < 3; ++d) {
-            a[d] = std::max(0, int(std::floor((q[d] - r - axis[d][0]) / g.h)));
-            b[d] = std::min(B, int(std::ceil((q[d] + r - axis[d][0]) / g.h)));
-        }
-        for (int k = a[2]; k <= b[2]; ++k) {
-            const double dz = axis[2][k] - q[2];
-            for (int j = a[1]; j <= b[1]; ++j) {
-                const double dy = axis[1][j] - q[1], dyz = dy * dy + dz * dz;
-                if (dyz > r2) continue;
-                for (int i = a[0]; i <= b[0]; ++i) {
-                    const double dx = axis[0][i] - q[0];
-                    if (dx * dx + dyz <= r2) trusted[size_t(local(i, j, k))] = 1;
-                }
-            }
-        }
-    }
-
-    double coarse[CC * CC * CC];
-    bool coarse_done[CC * CC * CC] = {};
-    auto far = [&](int i, int j, int k) {
-        const int c = i / S + CC * (j / S + CC * (k / S));
-        if (!coarse_done[c]) {
-            coarse[c] = f.far_value(g.corner(origin[0] + i, origin[1] + j, origin[2] + k), nullptr);
-            coarse_done[c] = true;
-        }
-        return coarse[c];
-    };
-    for (int k = 0; k < C; ++k)
-        for (int j = 0; j < C; ++j)
-            for (int i = 0; i < C; ++i) {
-                const int8_t forced = touches_far ? g.forced_sign(origin[0] + i, origin[1] + j, origin[2] + k) : 0;
-                double v;
-                if (forced != 0) {
-                    v = forced * g.h;
-                } else if (trusted[size_t(local(i, j, k))]) {
-                    v = f.mpu().value_among(leaves.at(i, j, k), g.corner(origin[0] + i, origin[1] + j, origin[2] + k),
-                                            nullptr);
-                } else {
-                    // Trilinear in the coarse cell holding the corner.
-                    const int ci = std::min(i / S, CC - 2) * S, cj = std::min(j / S, CC - 2) * S,
-                              ck = std::min(k / S, CC - 2) * S;
-                    const double u = double(i - ci) / S, w = double(j - cj) / S, t = double(k - ck) / S;
-                    v = 0.0;
-                    for (int c = 0; c < 8; ++c) {
-                        const int di = c & 1, dj = c >> 1 & 1, dk = c >> 2 & 1;
-                        const double weight = (di ? u : 1 - u) * (dj ? w : 1 - w) * (dk ? t : 1 - t);
-                        if (weight > 0.0) v += weight * far(ci + S * di, cj + S * dj, ck + S * dk);
-                    }
-                    if (v == 0.0) v = -g.h;  // exactly between: outside, like every tie
-                }
-                if (!std::isfinite(v)) v = -g.h;
-                value[size_t(local(i, j, k))] = v;
-            }
-}
 
 // Marching tetrahedra over one band block.
 void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuckets &buckets, const std::vector<int64_t> &band,
                       size_t band_index, BlockOutput &out) {
     const int64_t block = band[band_index];
-    constexpr int C = B + 1;
+    constexpr int C = B + 1;  // corners along a block's side
     thread_local std::vector<double> value(C * C * C);
+    thread_local std::vector<uint8_t> forced(C * C * C);
     thread_local std::vector<int32_t> slot(C * C * C * 8);
     thread_local SubBlockLeaves leaves;
 
@@ -180,7 +90,25 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuck
     const uint32_t *weight = buckets.weight.data() + buckets.begin(band_index);
     const size_t near_count = buckets.end(band_index) - buckets.begin(band_index);
     const Eigen::AlignedBox3d box = g.block_box(block);
-    corner_values(g, f, leaves, near, near_count, origin, value);
+    // Corner values: a function of the corner's position alone (never of the block), so
+    // neighbouring blocks agree on shared corners. A corner touching a far block takes that
+    // region's sign; every other corner asks the field.
+    const bool touches_far = g.touches_far(block);
+    if (touches_far)
+        for (int k = 0; k < C; ++k)
+            for (int j = 0; j < C; ++j)
+                for (int i = 0; i < C; ++i) {
+                    const int8_t sign = g.forced_sign(x0 + i, y0 + j, z0 + k);
+                    forced[size_t(local(i, j, k))] = sign != 0;
+                    if (sign != 0) value[size_t(local(i, j, k))] = sign * g.h;
+                }
+    LatticeBlock lattice;
+    lattice.grid_origin = g.origin;
+    lattice.h = g.h;
+    for (int d = 0; d < 3; ++d) lattice.start[d] = origin[d];
+    lattice.n = B;
+    for (int s = 0; s < 8; ++s) lattice.leaves[s] = &leaves.list[s];
+    f.block_values(lattice, near, near_count, touches_far ? forced.data() : nullptr, value.data());
     std::fill(slot.begin(), slot.end(), -1);
 
     auto vertex = [&](int i, int j, int k, const mt::Edge &e) -> uint32_t {
@@ -194,7 +122,7 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuck
         const Eigen::Vector3d pa = g.corner(x0 + ai, y0 + aj, z0 + ak), pb = g.corner(x0 + bi, y0 + bj, z0 + bk);
         const Eigen::Vector3d p = pa + t * (pb - pa);
         Eigen::Vector3d grad;
-        f.mpu().value_among(leaves.at(i, j, k), p, &grad);  // the cube (i, j, k) holds p
+        f.mpu().value_among(lattice.leaves_at(i, j, k), p, &grad);  // the cube (i, j, k) holds p
         s = int32_t(out.vertex_pos.size());
         out.vertex_pos.push_back(p);
         out.vertex_grad.push_back(grad);
@@ -236,58 +164,6 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuck
     }
 }
 
-// One vertex per grid edge across blocks: sort every block's vertices by edge key.
-// `votes` receives the point votes per welded vertex.
-Mesh weld(std::vector<BlockOutput> &blocks, const Normalisation &norm, Progress &progress,
-          std::vector<uint32_t> &votes) {
-    // Every big array is reserved up front: growing one by doubling copies tens of
-    // megabytes in one go, with no progress report in between.
-    size_t vertex_slots = 0, triangle_slots = 0;
-    for (const BlockOutput &block : blocks) vertex_slots += block.vertex_key.size(), triangle_slots += block.triangles.size();
-    std::vector<std::pair<uint64_t, uint64_t>> keyed;  // (edge key, block << 32 | local index)
-    keyed.reserve(vertex_slots);
-    for (size_t b = 0; b < blocks.size(); ++b) {
-        progress.poll(0.95);
-        for (size_t v = 0; v < blocks[b].vertex_key.size(); ++v) keyed.push_back({blocks[b].vertex_key[v], uint64_t(b) << 32 | v});
-    }
-    cancellable_sort(keyed, progress, 0.96);
-
-    size_t welded = 0;
-    for (size_t k = 0; k < keyed.size(); ++k) {
-        if (k % 65536 == 0) progress.poll(0.97);
-        welded += k == 0 || keyed[k].first != keyed[k - 1].first;
-    }
-    Mesh mesh;
-    mesh.vertices.reserve(3 * welded);
-    mesh.normals.reserve(3 * welded);
-    mesh.triangles.reserve(triangle_slots);
-    votes.reserve(welded);
-    std::vector<std::vector<uint32_t>> remap(blocks.size());
-    for (size_t b = 0; b < blocks.size(); ++b) {
-        progress.poll(0.97);
-        remap[b].resize(blocks[b].vertex_key.size());
-    }
-    for (size_t k = 0; k < keyed.size(); ++k) {
-        if (k % 4096 == 0) progress.poll(0.97);
-        const size_t b = keyed[k].second >> 32, v = keyed[k].second & 0xffffffffu;
-        if (k == 0 || keyed[k].first != keyed[k - 1].first) {
-            const Eigen::Vector3d p = norm.to_world(blocks[b].vertex_pos[v]);
-            Eigen::Vector3d n = -blocks[b].vertex_grad[v].normalized();  // f grows inward
-            if (!n.allFinite()) n = Eigen::Vector3d::UnitZ();
-            mesh.vertices.insert(mesh.vertices.end(), {p[0], p[1], p[2]});
-            mesh.normals.insert(mesh.normals.end(), {n[0], n[1], n[2]});
-            votes.push_back(0);
-        }
-        remap[b][v] = uint32_t(mesh.vertex_count() - 1);
-        votes.back() += blocks[b].votes[v];
-    }
-    for (size_t b = 0; b < blocks.size(); ++b) {
-        progress.poll(0.98);
-        for (uint32_t v : blocks[b].triangles) mesh.triangles.push_back(remap[b][v]);
-    }
-    return mesh;
-}
-
 }  // namespace
 
 int default_resolution(const Octree &tree) {
@@ -319,32 +195,36 @@ int default_resolution(const Octree &tree) {
     return std::clamp(int(std::ceil(1.0 / h)), 32, 1024);
 }
 
-Mesh polygonize(const MpuFunction &mpu, const WindingField &winding, const PointSet &points,
-                const PointMeasures &measures, int resolution, const Params &params, Progress &progress) {
+Mesh polygonize(const SurfaceField &field, int resolution, const Params &params, Workers &workers,
+                Progress &progress) {
+    const PointSet &points = field.points();
+    const PointMeasures &measures = field.measures();
+    // The steps' shares of the stage's progress: the grid and the point buckets, the blocks,
+    // the weld, the cleanup.
+    Progress grid_progress = progress.slice(0.0, 0.02), blocks_progress = progress.slice(0.02, 0.95),
+             weld_progress = progress.slice(0.95, 0.98), cleanup_progress = progress.slice(0.98, 1.0);
     const double h = 1.0 / resolution, min_trust = 2.0 * h;
     // Before allocating anything: the grid alone, then with the band, must fit the budget.
     const double grid_blocks = BlockGrid::blocks_for(points, resolution, std::max(measures.widest_trust, min_trust));
     check_memory(polygonize_memory(grid_blocks, 0, 0), params.max_memory, resolution_text(resolution).c_str());
-    const BlockGrid g(points, resolution, measures.trust_radius, min_trust, winding, progress);
-    // A band block meets some point's reach, so each of its corners has a point within that
-    // reach plus the block's diagonal: the bound for every neighbour search below.
-    const double reach = std::max(measures.widest_trust, min_trust) + B * std::sqrt(3.0) * h + h;
-    const SurfaceField f(mpu, points, measures, winding, min_trust, reach);
+    const BlockGrid g(points, resolution, measures.trust_radius, min_trust, field.winding(), grid_progress);
+    // A band block meets some point's (widened) trust ball, so each of its corners has a point
+    // within that radius plus the block's diagonal: the bound for every neighbour search below.
+    const double search_bound = std::max(measures.widest_trust, min_trust) + B * std::sqrt(3.0) * h + h;
+    const SurfaceField f = field.bounded(min_trust, search_bound);
     std::vector<int64_t> band;
     for (int64_t b = 0; b < int64_t(g.block_count()); ++b)
         if (g.band[size_t(b)]) band.push_back(b);
     const double band_blocks = double(band.size());
     check_memory(polygonize_memory(grid_blocks, band_blocks, band_blocks * kTrianglesPerBandBlock), params.max_memory,
                  resolution_text(resolution).c_str());
-    progress.report(0.02);
-    progress.throw_if_cancelled();
+    grid_progress.poll(1.0);
 
-    const PointBuckets buckets(g, band, f, progress, 0.02);
+    const PointBuckets buckets(g, band, f, grid_progress, 1.0);
     progress.throw_if_cancelled();
     std::vector<BlockOutput> blocks(band.size());
     std::atomic<uint64_t> triangles{0};
-    const double total = double(band.size()) / 0.93;
-    parallel_for(0, band.size(), resolve_threads(params.threads), progress, [&](size_t i) {
+    parallel_for(0, band.size(), workers, blocks_progress, [&](size_t i) {
         polygonize_block(g, f, buckets, band, i, blocks[i]);
         const uint64_t made = blocks[i].triangles.size() / 3;
         const double so_far = double(triangles.fetch_add(made) + made);
@@ -357,13 +237,12 @@ Mesh polygonize(const MpuFunction &mpu, const WindingField &winding, const Point
         // than the band suggested.
         check_memory(polygonize_memory(grid_blocks, band_blocks, so_far), params.max_memory,
                      resolution_text(resolution).c_str());
-    }, 0.02 * total, total, 1);  // one block per chunk: a cancel waits for one block per thread
+    }, 1);  // one block per chunk: a cancel waits for one block per thread
     progress.throw_if_cancelled();
-    progress.report(0.95);
     std::vector<uint32_t> votes;
-    Mesh mesh = weld(blocks, points.normalisation(), progress, votes);
+    Mesh mesh = weld(blocks, points.normalisation(), weld_progress, votes);
     progress.throw_if_cancelled();
-    remove_unsupported_components(mesh, votes, kMinVotes, progress);
+    remove_unsupported_components(mesh, votes, kMinVotes, cleanup_progress);
     return mesh;  // the caller makes the final report, once the temporaries are freed
 }
 

@@ -6,6 +6,7 @@
 // because every corner's value is a function of its position alone.
 #pragma once
 
+#include "core/parallel.hpp"
 #include "core/params.hpp"
 #include "core/progress.hpp"
 #include "geometry/point_set.hpp"
@@ -19,7 +20,7 @@ namespace gmpu {
 int default_resolution(const Octree &tree);
 
 // Throws CANCELLED or LIMIT_EXCEEDED (params.max_triangles).
-Mesh polygonize(const MpuFunction &mpu, const WindingField &winding, const PointSet &points,
-                const PointMeasures &measures, int resolution, const Params &params, Progress &progress);
+Mesh polygonize(const SurfaceField &field, int resolution, const Params &params, Workers &workers,
+                Progress &progress);
 
 }  // namespace gmpu

@@ -157,7 +157,7 @@ std::vector<int8_t> propagate_orientation(const Octree &tree, const LeafGraph &g
             label[v] = solver.solve(v);
             front.push_neighbours(v);
             if ((++done & 255) == 0) {
-                progress.report(0.1 + 0.7 * double(done) / double(g.size()));
+                progress.report(double(done) / double(g.size()));
                 progress.throw_if_cancelled();
             }
         }

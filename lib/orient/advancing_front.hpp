@@ -16,7 +16,7 @@
 #include <vector>
 
 #include "core/progress.hpp"
-#include "geometry/octree.hpp"
+#include "model/octree.hpp"
 #include "orient/leaf_graph.hpp"
 
 namespace gmpu {

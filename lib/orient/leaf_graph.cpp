@@ -59,7 +59,7 @@ struct HalfEdge {
 
 }  // namespace
 
-LeafGraph build_leaf_graph(const Octree &tree, unsigned threads, Progress &progress) {
+LeafGraph build_leaf_graph(const Octree &tree, Workers &workers, Progress &progress) {
     LeafGraph g;
     std::vector<uint32_t> node_of(tree.cells.size(), UINT32_MAX);
     for (uint32_t i = 0; i < tree.cells.size(); ++i)
@@ -73,7 +73,7 @@ LeafGraph build_leaf_graph(const Octree &tree, unsigned threads, Progress &progr
     // neighbour; the smaller side of a level change always does the finding, so each edge
     // is found exactly once.
     std::vector<std::vector<HalfEdge>> found(g.size());
-    parallel_for(0, g.size(), threads, progress, [&](size_t n) {
+    parallel_for(0, g.size(), workers, progress, [&](size_t n) {
         const Cell &a = tree.cells[g.cell_of[n]];
         const int32_t extent = 1 << a.depth;
         for (int axis = 0; axis < 3; ++axis)
@@ -97,7 +97,7 @@ LeafGraph build_leaf_graph(const Octree &tree, unsigned threads, Progress &progr
                 if (b.depth == a.depth && nb < n) continue;  // found from the other side
                 found[n].push_back({uint32_t(n), nb, face_agreement(tree, a, b, axis, side)});
             }
-    }, 0.0, double(g.size()) / 0.1, 256);  // the first 10 % of orient's bar (orient.cpp)
+    }, 256);
     progress.throw_if_cancelled();
 
     // CSR with both directions.

@@ -8,8 +8,9 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/parallel.hpp"
 #include "core/progress.hpp"
-#include "geometry/octree.hpp"
+#include "model/octree.hpp"
 
 namespace gmpu {
 
@@ -23,7 +24,7 @@ struct LeafGraph {
     size_t degree(uint32_t i) const { return offsets[i + 1] - offsets[i]; }
 };
 
-LeafGraph build_leaf_graph(const Octree &tree, unsigned threads, Progress &progress);
+LeafGraph build_leaf_graph(const Octree &tree, Workers &workers, Progress &progress);
 
 // Connected components of the graph: component id per node, and their count.
 std::vector<uint32_t> connected_components(const LeafGraph &graph, uint32_t &count);

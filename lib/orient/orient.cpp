@@ -3,7 +3,6 @@
 #include <cmath>
 
 #include "core/parallel.hpp"
-#include "core/resize_reporting.hpp"
 #include "orient/advancing_front.hpp"
 #include "orient/leaf_graph.hpp"
 #include "orient/outward.hpp"
@@ -13,12 +12,14 @@ namespace gmpu {
 namespace {
 
 // Signs each leaf by its points' normals: ∇f must point inward, against the normals.
-void sign_leaves_by_normals(Octree &tree, const PointSet &points, const float *normals, Progress &progress) {
+void sign_leaves_by_normals(const Octree &tree, const PointSet &points, const float *normals, CellSigns &signs,
+                            Progress &progress) {
     std::vector<uint32_t> idx;
     std::vector<float> d2;
     Eigen::Vector3d g;
-    for (Cell &c : tree.cells) {
-        progress.poll(0.85 * double(&c - tree.cells.data()) / double(tree.cells.size()));  // O(n) in all
+    for (const Cell &c : tree.cells) {
+        const size_t index = size_t(&c - tree.cells.data());
+        progress.poll(double(index) / double(tree.cells.size()));  // O(n) in all
         if (!c.is_leaf()) continue;
         idx.assign(tree.order.begin() + c.point_begin, tree.order.begin() + c.point_end);
         if (idx.empty()) points.nearest(c.centre, 8, idx, d2);  // a leaf holding no point
@@ -27,20 +28,19 @@ void sign_leaves_by_normals(Octree &tree, const PointSet &points, const float *n
             c.shape.value(points.point(i) - c.centre, tree.pieces, &g);
             vote += g.dot(Eigen::Vector3d(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]));
         }
-        c.sign = vote > 0.0 ? -1 : 1;
-        c.oriented = true;
+        signs[index] = vote > 0.0 ? -1 : 1;
     }
 }
 
 // Inner cells follow their oriented children: the sign that makes the cell's gradient
 // agree with theirs at the children's points. Children come after parents, so a reverse
 // sweep sees every child oriented before its parent.
-void sign_inner_cells(Octree &tree, const PointSet &points, Progress &progress) {
+void sign_inner_cells(const Octree &tree, const PointSet &points, CellSigns &signs, Progress &progress) {
     constexpr uint32_t kSamplesPerChild = 16;
     Eigen::Vector3d gp, gc;
     for (size_t i = tree.cells.size(); i-- > 0;) {
-        progress.poll(0.9 - 0.05 * double(i) / double(tree.cells.size()));  // ~0.2 s a million points
-        Cell &c = tree.cells[i];
+        progress.poll(1.0 - double(i) / double(tree.cells.size()));
+        const Cell &c = tree.cells[i];
         if (c.is_leaf()) continue;
         double vote = 0.0;
         for (int o = 0; o < 8; ++o) {
@@ -52,76 +52,42 @@ void sign_inner_cells(Octree &tree, const PointSet &points, Progress &progress) 
             for (uint32_t j = child.point_begin; j < child.point_end; j += step) {
                 Eigen::Vector3d p = points.point(tree.order[j]);
                 c.shape.value(p - c.centre, tree.pieces, &gp);
-                child.value(p, tree.pieces, &gc);
+                oriented_value(child, signs[size_t(k)], p, tree.pieces, &gc);
                 vote += gp.normalized().dot(gc.normalized());
             }
         }
-        c.sign = vote < 0.0 ? -1 : 1;
-        c.oriented = true;
+        signs[i] = vote < 0.0 ? -1 : 1;
     }
 }
 
 }  // namespace
 
-OrientStats orient_octree(Octree &tree, const PointSet &points, const float *normals,
-                          const Params &params, Progress &progress, const FrontOptions &front) {
-    for (Cell &c : tree.cells) c.sign = 1, c.oriented = false;
-    OrientStats stats;
-    const unsigned threads = resolve_threads(params.threads);
+Orientation orient_octree(const Octree &tree, const PointSet &points, const float *normals, Workers &workers,
+                          Progress &progress, const FrontOptions &front) {
+    Orientation result;
+    CellSigns &signs = result.signs;
+    OrientStats &stats = result.stats;
+    signs.assign(tree.cells.size(), 1);
+    // The steps' shares of the progress this function is handed.
+    Progress leaves_progress = progress.slice(0.0, 0.9), inner_progress = progress.slice(0.9, 1.0);
     if (normals) {
-        sign_leaves_by_normals(tree, points, normals, progress);
+        sign_leaves_by_normals(tree, points, normals, signs, leaves_progress);
         stats.components = 1;
     } else {
-        LeafGraph graph = build_leaf_graph(tree, threads, progress);
-        progress.report(0.1);
+        Progress graph_progress = leaves_progress.slice(0.0, 0.1), front_progress = leaves_progress.slice(0.1, 0.85),
+                 outward_progress = leaves_progress.slice(0.85, 1.0);
+        LeafGraph graph = build_leaf_graph(tree, workers, graph_progress);
+        graph_progress.report(1.0);
         std::vector<uint32_t> component = connected_components(graph, stats.components);
         std::vector<int8_t> label =
-            propagate_orientation(tree, graph, component, stats.components, front, progress);
-        for (uint32_t v = 0; v < graph.size(); ++v) {
-            Cell &c = tree.cells[graph.cell_of[v]];
-            c.sign = label[v];
-            c.oriented = true;
-        }
-        make_components_outward(tree, points, graph, component, stats.components, progress);
+            propagate_orientation(tree, graph, component, stats.components, front, front_progress);
+        for (uint32_t v = 0; v < graph.size(); ++v) signs[graph.cell_of[v]] = label[v];
+        make_components_outward(tree, signs, points, graph, component, stats.components, outward_progress);
     }
     progress.throw_if_cancelled();
-    sign_inner_cells(tree, points, progress);
-    for (const Cell &c : tree.cells) stats.flipped_leaves += c.is_leaf() && c.sign < 0;
-    return stats;
-}
-
-std::vector<float> point_normals(const MpuFunction &f, const PointSet &points, unsigned threads,
-                                 Progress &progress, double done_before, double total) {
-    const Octree &tree = f.tree();
-    std::vector<float> out;
-    assign_reporting(out, 3 * points.size(), progress);
-    std::vector<uint32_t> leaves;
-    for (uint32_t i = 0; i < tree.cells.size(); ++i)
-        if (tree.cells[i].is_leaf() && tree.cells[i].point_end > tree.cells[i].point_begin) leaves.push_back(i);
-    parallel_for(0, leaves.size(), threads, progress, [&](size_t l) {
-        const Cell &c = tree.cells[leaves[l]];
-        // The leaves blending inside this cell, gathered once for all its points.
-        thread_local std::vector<uint32_t> near;
-        const Eigen::Vector3d half = Eigen::Vector3d::Constant(0.5 * c.size);
-        f.gather(Eigen::AlignedBox3d(c.centre - half, c.centre + half), near);
-        Eigen::Vector3d g;
-        for (uint32_t k = c.point_begin; k < c.point_end; ++k) {
-            // A coarse leaf can hold thousands of points: report within it too.
-            if ((k - c.point_begin) % 16 == 15) progress.tick();
-            uint32_t i = tree.order[k];
-            Eigen::Vector3d p = points.point(i);
-            f.value_among(near, p, &g);
-            double gn = g.norm();
-            if (!(gn > 1e-12) || !g.allFinite()) {
-                c.value(p, tree.pieces, &g);  // ∇f vanishes: the oriented local fit
-                gn = g.norm();
-            }
-            Eigen::Vector3d n = gn > 0.0 ? Eigen::Vector3d(-g / gn) : Eigen::Vector3d::UnitZ();
-            for (int d = 0; d < 3; ++d) out[3 * i + d] = float(n[d]);
-        }
-    }, done_before, total, 1);  // leaves come coarsest first: one per chunk
-    progress.throw_if_cancelled();
-    return out;
+    sign_inner_cells(tree, points, signs, inner_progress);
+    for (size_t i = 0; i < tree.cells.size(); ++i) stats.flipped_leaves += tree.cells[i].is_leaf() && signs[i] < 0;
+    return result;
 }
 
 }  // namespace gmpu

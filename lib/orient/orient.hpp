@@ -1,5 +1,5 @@
-// Orient stage: gives every cell's local function its sign, so that the blend is one
-// consistent field, positive inside. Without input normals: leaf graph → belief
+// Orient stage: a sign for every cell's local function (kept beside the fitted tree, which
+// it does not change), so that the blend is one consistent field, positive inside. Without input normals: leaf graph → belief
 // propagation advanced as a front per component → each component made outward. With
 // input normals: each leaf takes the sign its points' normals vote for. Either way the
 // inner cells (used by the level-of-detail cap and far-field fallback) then follow their
@@ -9,11 +9,11 @@
 #include <cstdint>
 #include <vector>
 
+#include "core/parallel.hpp"
 #include "core/params.hpp"
 #include "core/progress.hpp"
-#include "geometry/octree.hpp"
+#include "model/octree.hpp"
 #include "geometry/point_set.hpp"
-#include "implicit/mpu_function.hpp"
 #include "orient/advancing_front.hpp"
 
 namespace gmpu {
@@ -23,14 +23,14 @@ struct OrientStats {
     uint32_t flipped_leaves = 0;
 };
 
-// normals: 3 per point (normalised frame directions) or null. `front` is for measurements
-// only (advancing_front.hpp); the C ABI always passes the defaults.
-OrientStats orient_octree(Octree &tree, const PointSet &points, const float *normals,
-                          const Params &params, Progress &progress, const FrontOptions &front = {});
+struct Orientation {
+    CellSigns signs;  // one per cell of the tree
+    OrientStats stats;
+};
 
-// Unit outward normal at every input point: −∇f/|∇f|, or the oriented fit of the point's
-// leaf where ∇f vanishes. 3 floats per point.
-std::vector<float> point_normals(const MpuFunction &f, const PointSet &points, unsigned threads,
-                                 Progress &progress, double done_before, double total);
+// The fitted tree's signs. normals: 3 per point (normalised frame directions) or null.
+// `front` is for measurements only (advancing_front.hpp); the C ABI always passes the defaults.
+Orientation orient_octree(const Octree &tree, const PointSet &points, const float *normals, Workers &workers,
+                          Progress &progress, const FrontOptions &front = {});
 
 }  // namespace gmpu

@@ -3,7 +3,7 @@
 // the per-point measures), so one check before it starts covers the stage.
 #pragma once
 
-#include "geometry/octree.hpp"
+#include "model/octree.hpp"
 #include "geometry/point_set.hpp"
 
 namespace gmpu {

@@ -6,6 +6,9 @@ namespace gmpu {
 
 namespace {
 
+// Share of this step's progress for the leaves' moments; the nesting test takes the rest.
+constexpr double kMomentsShare = 0.8;
+
 // Oriented surface samples of one leaf, aggregated: Σ A n (the leaf's dipole), the centroid
 // of its points, and its contribution to (1/3)∮ x·n dA.
 struct LeafMoment {
@@ -15,14 +18,14 @@ struct LeafMoment {
     uint32_t count = 0;
 };
 
-LeafMoment leaf_moment(const Octree &tree, const PointSet &points, const Cell &c) {
+LeafMoment leaf_moment(const Octree &tree, const PointSet &points, const Cell &c, int8_t sign) {
     LeafMoment m;
     // Area per point from the support's density: the ball meets the surface in about a disk.
     const double area = M_PI * c.radius * c.radius / double(std::max<uint32_t>(1, c.support_count));
     Eigen::Vector3d g;
     for (uint32_t k = c.point_begin; k < c.point_end; ++k) {
         Eigen::Vector3d p = points.point(tree.order[k]);
-        c.value(p, tree.pieces, &g);
+        oriented_value(c, sign, p, tree.pieces, &g);
         double gn = g.norm();
         if (!(gn > 0.0)) continue;
         Eigen::Vector3d n = -g / gn;  // outward if f is positive inside
@@ -37,13 +40,13 @@ LeafMoment leaf_moment(const Octree &tree, const PointSet &points, const Cell &c
 
 }  // namespace
 
-size_t make_components_outward(Octree &tree, const PointSet &points, const LeafGraph &g,
+size_t make_components_outward(const Octree &tree, CellSigns &signs, const PointSet &points, const LeafGraph &g,
                                const std::vector<uint32_t> &component, uint32_t count, Progress &progress) {
     std::vector<LeafMoment> moment(g.size());
     std::vector<double> volume(count, 0.0);
     for (uint32_t v = 0; v < g.size(); ++v) {
-        progress.poll(0.8 + 0.04 * double(v) / double(g.size()));  // every point once: O(n)
-        moment[v] = leaf_moment(tree, points, tree.cells[g.cell_of[v]]);
+        progress.poll(kMomentsShare * double(v) / double(g.size()));  // every point once: O(n)
+        moment[v] = leaf_moment(tree, points, tree.cells[g.cell_of[v]], signs[g.cell_of[v]]);
         volume[component[v]] += moment[v].volume;
     }
     // 1. Each piece on its own: positive enclosed volume.
@@ -67,7 +70,7 @@ size_t make_components_outward(Octree &tree, const PointSet &points, const LeafG
         }
         std::vector<int8_t> parity(count, 1);
         for (uint32_t c = 0; c < count; ++c) {
-            progress.poll(0.84 + 0.01 * double(c) / double(count));  // O(count × leaves) in all
+            progress.poll(kMomentsShare + (1.0 - kMomentsShare) * double(c) / double(count));  // O(count × leaves)
             if (!probe_count[c]) continue;
             const Eigen::Vector3d q = probe[c];
             std::vector<double> winding(count, 0.0);
@@ -92,8 +95,8 @@ size_t make_components_outward(Octree &tree, const PointSet &points, const LeafG
     size_t flipped = 0;
     for (uint32_t v = 0; v < g.size(); ++v)
         if (flip[component[v]] < 0) {
-            Cell &cell = tree.cells[g.cell_of[v]];
-            cell.sign = int8_t(-cell.sign);
+            int8_t &sign = signs[g.cell_of[v]];
+            sign = int8_t(-sign);
             ++flipped;
         }
     return flipped;

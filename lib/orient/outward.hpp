@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "core/progress.hpp"
-#include "geometry/octree.hpp"
+#include "model/octree.hpp"
 #include "geometry/point_set.hpp"
 #include "orient/leaf_graph.hpp"
 
@@ -19,7 +19,7 @@ namespace gmpu {
 // Flips every leaf of a component whose sign is inward. Leaf signs must already be
 // consistent within components. Returns the number of leaves flipped. Reports progress
 // between 0.8 and 0.85 and throws CANCELLED.
-size_t make_components_outward(Octree &tree, const PointSet &points, const LeafGraph &graph,
+size_t make_components_outward(const Octree &tree, CellSigns &signs, const PointSet &points, const LeafGraph &graph,
                                const std::vector<uint32_t> &component, uint32_t component_count,
                                Progress &progress);
 

@@ -18,6 +18,7 @@
 #include "geometry/point_set.hpp"
 #include "gmpu/gmpu.h"
 #include "implicit/mpu_function.hpp"
+#include "implicit/point_measures.hpp"
 #include "orient/orient.hpp"
 
 using namespace gmpu;
@@ -73,18 +74,19 @@ int main(int argc, char **argv) {
             const Params params;
             Progress quiet(nullptr, nullptr, GMPU_STAGE_FIT);
             const double eps = effective_epsilon(points, params, estimate_noise(points, quiet));
-            const Octree fitted = build_octree(points, params, eps, quiet);
+            Workers workers(0);
+            const Octree fitted = build_octree(points, params, eps, workers, quiet);
             size_t leaves = 0;
             for (const Cell &c : fitted.cells) leaves += c.is_leaf();
             std::printf("%s\t%zu\t%zu", path.substr(path.rfind('/') + 1).c_str(), n, leaves);
             for (const Variant &v : kVariants) {
-                Octree tree = fitted;
+                const Octree &tree = fitted;  // orient leaves the fit as it is
                 FrontOptions front;
                 front.order = v.order;
                 front.decision = v.decision;
-                orient_octree(tree, points, nullptr, params, quiet, front);
-                const MpuFunction f(tree, 0);
-                const std::vector<float> normals = point_normals(f, points, resolve_threads(0), quiet, 0.0, double(n));
+                const Orientation orientation = orient_octree(tree, points, nullptr, workers, quiet, front);
+                const MpuFunction f(tree, orientation.signs, 0);
+                const std::vector<float> normals = point_normals(f, points, workers, quiet);
                 size_t right = 0;
                 for (size_t i = 0; i < n; ++i) {
                     double dot = 0.0;

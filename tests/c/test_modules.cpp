@@ -5,7 +5,11 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <chrono>
 #include <map>
+#include <mutex>
+#include <set>
+#include <thread>
 #include <random>
 #include <cstdlib>
 #include <cstring>
@@ -350,14 +354,16 @@ void blend_finds_every_covering_leaf(void **) {
     PointSet ps = PointSet::from_array(xyz.data(), 3000, 0, 15);
     Params params;
     Progress progress(nullptr, nullptr, GMPU_STAGE_FIT);
-    Octree tree = build_octree(ps, params, 0.001, progress);
+    Workers workers(2);
+    Octree tree = build_octree(ps, params, 0.001, workers, progress);
     size_t grown = 0;
     for (const Cell &c : tree.cells)
         if (c.parent >= 0 && (c.centre - tree.cells[size_t(c.parent)].centre).norm() + c.radius >
                                  tree.cells[size_t(c.parent)].radius)
             ++grown;
     assert_true(grown > 0);  // the case this test is about
-    MpuFunction f(tree, 0);
+    const CellSigns as_fitted;
+    MpuFunction f(tree, as_fitted, 0);
     std::mt19937_64 rng(5);
     std::uniform_real_distribution<double> u(-0.6, 0.6);
     std::vector<uint32_t> near;
@@ -403,7 +409,8 @@ void winding_number_of_a_sampled_sphere(void **) {
     }
     Params params;
     Progress progress(nullptr, nullptr, GMPU_STAGE_ORIENT);
-    Octree tree = build_octree(ps, params, 1e-5, progress);  // below the jitter: a deep octree
+    Workers workers(2);
+    Octree tree = build_octree(ps, params, 1e-5, workers, progress);  // below the jitter: a deep octree
     assert_true(tree.cells.size() > 100);
     WindingField w(tree, ps, normals, area, &progress);
     std::mt19937_64 rng(3);
@@ -551,18 +558,22 @@ void unsupported_components_are_dropped(void **) {
 void parallel_for_runs_each_index_once(void **) {
     Progress progress(nullptr, nullptr, GMPU_STAGE_FIT);
     std::vector<std::atomic<int>> hits(10007);
-    parallel_for(0, hits.size(), 4, progress, [&](size_t i) { hits[i]++; });
-    for (auto &h : hits) assert_int_equal(h.load(), 1);
+    Workers workers(4);
+    parallel_for(0, hits.size(), workers, progress, [&](size_t i) { hits[i]++; });
+    // The same pool again: its threads are reused, every index still runs once.
+    parallel_for(0, hits.size(), workers, progress, [&](size_t i) { hits[i]++; });
+    for (auto &h : hits) assert_int_equal(h.load(), 2);
 }
 
 void parallel_for_rethrows_and_cancels(void **) {
     Progress progress(nullptr, nullptr, GMPU_STAGE_FIT);
     std::atomic<size_t> ran{0};
     gmpu_status s = status_of([&] {
-        parallel_for(0, 100000, 2, progress, [&](size_t i) {
+        Workers workers(2);
+        parallel_for(0, 100000, workers, progress, [&](size_t i) {
             ++ran;
             if (i == 50) throw Error(GMPU_ERROR_INTERNAL, "boom");
-        }, 0, 0, 1);
+        }, 1);
     });
     assert_int_equal(s, GMPU_ERROR_INTERNAL);
     assert_true(ran.load() < 100000);  // the others stopped early
@@ -573,6 +584,52 @@ void parallel_for_rethrows_and_cancels(void **) {
     cancelling.report(0.1, true);
     assert_true(cancelling.cancelled());
     assert_int_equal(status_of([&] { cancelling.throw_if_cancelled(); }), GMPU_ERROR_CANCELLED);
+}
+
+void workers_are_reused_across_loops(void **) {
+    // Every thread that runs a body gets a token the first time (thread_local: a new thread
+    // starts without one). Helpers kept by the pool show the same tokens in the second loop;
+    // threads started per loop would bring new ones.
+    Progress progress(nullptr, nullptr, GMPU_STAGE_FIT);
+    Workers workers(3);
+    static std::atomic<int> tokens{0};
+    static thread_local int token = 0;
+    const auto caller = std::this_thread::get_id();
+    std::mutex m;
+    std::set<int> helper_tokens;
+    for (int loop = 0; loop < 2; ++loop)
+        parallel_for(0, 64, workers, progress, [&](size_t) {
+            if (token == 0) token = ++tokens;
+            if (std::this_thread::get_id() != caller) {
+                std::lock_guard<std::mutex> lock(m);
+                helper_tokens.insert(token);
+            }
+            std::this_thread::sleep_for(std::chrono::milliseconds(2));  // time for the helpers to join in
+        }, 1);
+    assert_true(!helper_tokens.empty());
+    assert_true(helper_tokens.size() <= workers.threads() - 1);
+}
+
+void progress_slices_map_onto_the_stage(void **) {
+    std::vector<double> seen;
+    Progress progress([](void *user, gmpu_stage, double f) -> int {
+        static_cast<std::vector<double> *>(user)->push_back(f);
+        return 0;
+    }, &seen, GMPU_STAGE_ORIENT);
+    Progress step = progress.slice(0.2, 0.6);
+    Progress inner = step.slice(0.5, 1.0);  // 0.4 .. 0.6 of the stage
+    step.report(0.5, true);
+    inner.report(0.5, true);
+    inner.report(1.0, true);
+    progress.report(0.1, true);  // never backwards
+    assert_int_equal(seen.size(), 4);
+    assert_true(std::fabs(seen[0] - 0.4) < 1e-12);
+    assert_true(std::fabs(seen[1] - 0.5) < 1e-12);
+    assert_true(std::fabs(seen[2] - 0.6) < 1e-12);
+    assert_true(std::fabs(seen[3] - 0.6) < 1e-12);
+    // One cancel flag for the stage and all its slices.
+    inner.cancel();
+    assert_true(progress.cancelled());
 }
 
 void cancellable_sort_sorts_and_cancels(void **) {
@@ -636,6 +693,8 @@ int main(void) {
         cmocka_unit_test(unsupported_components_are_dropped),
         cmocka_unit_test(parallel_for_runs_each_index_once),
         cmocka_unit_test(parallel_for_rethrows_and_cancels),
+        cmocka_unit_test(workers_are_reused_across_loops),
+        cmocka_unit_test(progress_slices_map_onto_the_stage),
         cmocka_unit_test(cancellable_sort_sorts_and_cancels),
         cmocka_unit_test(assign_reporting_fills_and_cancels),
     };

@@ -113,7 +113,8 @@ Octree two_level_octree(int flipped) {
 void leaf_graph_of_a_known_octree(void **) {
     Progress quiet(nullptr, nullptr, GMPU_STAGE_ORIENT);
     Octree t = two_level_octree(-1);
-    LeafGraph g = build_leaf_graph(t, 2, quiet);
+    Workers workers(2);
+    LeafGraph g = build_leaf_graph(t, workers, quiet);
     assert_int_equal(g.size(), 15);
     // 7 large leaves: 12 faces of a 2×2×2 block less the 3 of the split octant = 9 edges;
     // 8 small leaves among themselves: 12; the split octant's 3 large neighbours touch 4
@@ -133,7 +134,8 @@ void leaf_graph_of_a_known_octree(void **) {
     // Negate one small leaf's shape: exactly its edges disagree, at all four corners.
     const uint32_t flipped = 9;  // octant 0 of the split octant, at the root's centre
     t = two_level_octree(int(flipped));
-    g = build_leaf_graph(t, 1, quiet);
+    Workers one(1);
+    g = build_leaf_graph(t, one, quiet);
     int disagreeing = 0;
     for (const auto &[a, b, j] : edges_of(g)) {
         const bool touches = g.cell_of[a] == flipped || g.cell_of[b] == flipped;
@@ -162,7 +164,8 @@ PointSet sphere_set(size_t n, double r, const Vector3d &centre, std::vector<doub
 Octree fitted(const PointSet &ps) {
     Progress quiet(nullptr, nullptr, GMPU_STAGE_FIT);
     Params params;
-    return build_octree(ps, params, effective_epsilon(ps, params, 0.0), quiet);
+    Workers workers(2);
+    return build_octree(ps, params, effective_epsilon(ps, params, 0.0), workers, quiet);
 }
 
 void leaf_graph_matches_brute_force_on_a_fitted_octree(void **) {
@@ -170,7 +173,8 @@ void leaf_graph_matches_brute_force_on_a_fitted_octree(void **) {
     PointSet ps = sphere_set(4000, 1.0, Vector3d(0.3, -0.2, 0.1), nullptr, 0.15);
     Progress quiet(nullptr, nullptr, GMPU_STAGE_ORIENT);
     Octree t = fitted(ps);
-    LeafGraph g = build_leaf_graph(t, 2, quiet);
+    Workers workers(2);
+    LeafGraph g = build_leaf_graph(t, workers, quiet);
     assert_true(g.size() > 50);
     std::set<std::pair<uint32_t, uint32_t>> found;
     for (const auto &[a, b, j] : edges_of(g)) {
@@ -282,10 +286,11 @@ void bp_is_right_where_the_vote_is_wrong(void **) {
 // Share of leaves holding points whose oriented fit has its normal (−∇f) along `outward`
 // at the leaf's points, for points with `select`.
 template <class Select, class Outward>
-double share_facing(const Octree &t, const PointSet &ps, Select select, Outward outward) {
+double share_facing(const Octree &t, const CellSigns &signs, const PointSet &ps, Select select, Outward outward) {
     int right = 0, total = 0;
     for (const Cell &c : t.cells) {
         if (!c.is_leaf() || c.point_end == c.point_begin) continue;
+        const int8_t sign = signs[size_t(&c - t.cells.data())];
         double s = 0.0;
         bool any = false;
         Vector3d g;
@@ -293,7 +298,7 @@ double share_facing(const Octree &t, const PointSet &ps, Select select, Outward 
             Vector3d p = ps.point(t.order[k]);
             if (!select(p)) continue;
             any = true;
-            c.value(p, t.pieces, &g);
+            oriented_value(c, sign, p, t.pieces, &g);
             s += -g.normalized().dot(outward(p));
         }
         if (!any) continue;
@@ -311,22 +316,24 @@ void outward_pass_orients_nested_shells(void **) {
     PointSet ps = sphere_set(6000, 0.5, Vector3d::Zero(), &xyz);
     Progress quiet(nullptr, nullptr, GMPU_STAGE_ORIENT);
     Octree t = fitted(ps);
-    Params params;
-    OrientStats stats = orient_octree(t, ps, nullptr, params, quiet);
+    Workers workers(2);
+    Orientation orientation = orient_octree(t, ps, nullptr, workers, quiet);
+    const OrientStats &stats = orientation.stats;
+    CellSigns &signs = orientation.signs;
     assert_int_equal(stats.components, 2);
     const double split = 0.75 * 0.5;  // between the shells, in the normalised frame (scale 1/2)
     auto outer = [&](const Vector3d &p) { return p.norm() > split; };
     auto inner = [&](const Vector3d &p) { return p.norm() < split; };
     auto radial = [](const Vector3d &p) { return Vector3d(p.normalized()); };
     auto inward = [](const Vector3d &p) { return Vector3d(-p.normalized()); };
-    assert_true(share_facing(t, ps, outer, radial) > 0.99);
-    assert_true(share_facing(t, ps, inner, inward) > 0.99);
+    assert_true(share_facing(t, signs, ps, outer, radial) > 0.99);
+    assert_true(share_facing(t, signs, ps, inner, inward) > 0.99);
 
     // Turn the inner shell inside out by hand: the pass must turn exactly it back.
-    LeafGraph g = build_leaf_graph(t, 2, quiet);
+    LeafGraph g = build_leaf_graph(t, workers, quiet);
     uint32_t count = 0;
     std::vector<uint32_t> comp = connected_components(g, count);
-    assert_int_equal(make_components_outward(t, ps, g, comp, count, quiet), 0);  // already right
+    assert_int_equal(make_components_outward(t, signs, ps, g, comp, count, quiet), 0);  // already right
     uint32_t inner_component = UINT32_MAX;
     for (uint32_t v = 0; v < g.size() && inner_component == UINT32_MAX; ++v) {
         const Cell &c = t.cells[g.cell_of[v]];
@@ -334,13 +341,13 @@ void outward_pass_orients_nested_shells(void **) {
     }
     size_t inner_leaves = 0;
     for (uint32_t v = 0; v < g.size(); ++v) {
-        Cell &c = t.cells[g.cell_of[v]];
-        if (comp[v] == inner_component) c.sign = int8_t(-c.sign), ++inner_leaves;
+        int8_t &sign = signs[g.cell_of[v]];
+        if (comp[v] == inner_component) sign = int8_t(-sign), ++inner_leaves;
     }
-    assert_true(share_facing(t, ps, inner, inward) < 0.01);
-    assert_int_equal(make_components_outward(t, ps, g, comp, count, quiet), inner_leaves);
-    assert_true(share_facing(t, ps, inner, inward) > 0.99);
-    assert_true(share_facing(t, ps, outer, radial) > 0.99);
+    assert_true(share_facing(t, signs, ps, inner, inward) < 0.01);
+    assert_int_equal(make_components_outward(t, signs, ps, g, comp, count, quiet), inner_leaves);
+    assert_true(share_facing(t, signs, ps, inner, inward) > 0.99);
+    assert_true(share_facing(t, signs, ps, outer, radial) > 0.99);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // The adaptive octree of MPU: cells with a centre, a spherical support and a local shape
-// function. Built by fit (lib/fit/build_octree.cpp), signed by orient, read by the implicit
-// function and the polygonizer. The root is the cube of 1.2 × the longest side of the
+// function. Built by fit (lib/fit/build_octree.cpp) and never changed after; orient's result
+// is a sign per cell kept beside it (CellSigns); the implicit function and the polygonizer
+// read both. The root is the cube of 1.2 × the longest side of the
 // normalised bounding box (which is 1), centred at the origin.
 #pragma once
 
@@ -9,7 +10,7 @@
 
 #include <Eigen/Core>
 
-#include "fit/local_shape.hpp"
+#include "model/local_shape.hpp"
 
 namespace gmpu {
 
@@ -22,7 +23,7 @@ struct Cell {
     double radius = 0.0;   // support radius R (after growing to hold N_min points)
     // Radius around the centre that holds the support ball of this cell and of every cell
     // below it: a grown child's ball can reach beyond its parent's, so searches prune on this.
-    double reach = 0.0;
+    double subtree_radius = 0.0;
     uint16_t coord[3] = {0, 0, 0};  // integer position among the cells of its depth
     uint8_t depth = 0;
     uint8_t child_mask = 0;          // which of the 8 octants have a child
@@ -33,8 +34,6 @@ struct Cell {
     uint32_t initial_count = 0;       // points in the ungrown ball (capped at N_min)
     float error = 0.0f;               // Taubin distance error of the fit (normalised units)
     float variation = 0.0f;           // PCA surface variation σ of the support
-    int8_t sign = 1;                  // orientation label ℓ_i applied to the shape
-    bool oriented = false;
     bool unresolved_sheets = false;   // fit saw two sheets it could not model: split anyway
     // Factor on the cell's partition-of-unity weight: 1, except for a leaf whose fit misses
     // ε but which could not be split because no child would be near the data (see
@@ -43,16 +42,22 @@ struct Cell {
     LocalShape shape;
 
     bool is_leaf() const { return child_mask == 0; }
-    double value(const Eigen::Vector3d &x, const std::vector<PiecewiseShape> &pieces,
-                 Eigen::Vector3d *gradient) const {
-        double v = shape.value(x - centre, pieces, gradient);
-        if (sign < 0) {
-            if (gradient) *gradient = -*gradient;
-            return -v;
-        }
-        return v;
-    }
 };
+
+// Orientation labels ℓ_i, one per cell: +1 keeps the fitted sign of the cell's shape, −1
+// flips it. Empty: every cell as fitted.
+using CellSigns = std::vector<int8_t>;
+
+// ℓ_i Q_i(x), the cell's oriented local function at x (gradient written if asked).
+inline double oriented_value(const Cell &c, int8_t sign, const Eigen::Vector3d &x,
+                             const std::vector<PiecewiseShape> &pieces, Eigen::Vector3d *gradient) {
+    const double v = c.shape.value(x - c.centre, pieces, gradient);
+    if (sign < 0) {
+        if (gradient) *gradient = -*gradient;
+        return -v;
+    }
+    return v;
+}
 
 struct Octree {
     std::vector<Cell> cells;             // cells[0] is the root; parents before children

@@ -1,4 +1,4 @@
-#include "fit/quadric.hpp"
+#include "model/quadric.hpp"
 
 namespace gmpu {
 

@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "fit/quadric.hpp"
+#include "model/quadric.hpp"
 
 namespace gmpu {
 

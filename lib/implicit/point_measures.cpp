@@ -1,0 +1,101 @@
+#include "implicit/point_measures.hpp"
+
+#include <cmath>
+
+#include "core/resize_reporting.hpp"
+
+namespace gmpu {
+
+namespace {
+
+constexpr size_t kNeighbours = 8;
+// Trust extends this many k-th-neighbour distances from a point: enough to bridge the
+// gaps between samples so the trusted shell around the surface has no holes.
+constexpr double kTrustSpacings = 1.5;
+// Up to this many points, the areas come from every point's own neighbours.
+constexpr size_t kExactMeasureLimit = 1u << 17;
+
+// Area and trust radius of every point, from its k-th neighbour distance.
+void measure_areas(const Octree &tree, const PointSet &points, Workers &workers, Progress &progress,
+                   PointMeasures &out) {
+    const size_t n = points.size();
+    assign_reporting(out.area, n, progress);
+    assign_reporting(out.trust_radius, n, progress);
+    auto set = [&](uint32_t i, double rk) {
+        out.area[i] = float(M_PI * rk * rk / double(kNeighbours));
+        out.trust_radius[i] = float(kTrustSpacings * rk);
+    };
+    if (n <= kExactMeasureLimit) {
+        // The k-th neighbour distance of every point: exact, and what sparse or nonuniform
+        // clouds need.
+        parallel_for(0, n, workers, progress, [&](size_t i) {
+            thread_local std::vector<uint32_t> idx;
+            thread_local std::vector<float> d2;
+            points.nearest(points.point(i), kNeighbours + 1, idx, d2);  // includes the point itself
+            set(uint32_t(i), std::sqrt(double(d2.back())));
+        }, 512);
+        progress.throw_if_cancelled();
+    } else {
+        // Dense clouds: the density of each leaf's support, as if the surface crossed its ball
+        // through the centre (π R² of area for its points), gives the k-th neighbour distance
+        // sqrt(k · area per point / π) without a million neighbour searches.
+        for (const Cell &c : tree.cells) {
+            progress.tick();
+            if (!c.is_leaf() || c.point_end == c.point_begin) continue;
+            const double area = M_PI * c.radius * c.radius / double(std::max<uint32_t>(1, c.support_count));
+            const double rk = std::sqrt(double(kNeighbours) * area / M_PI);
+            for (uint32_t k = c.point_begin; k < c.point_end; ++k) set(tree.order[k], rk);
+        }
+    }
+    out.widest_trust = 0.0;
+    for (float r : out.trust_radius) out.widest_trust = std::max(out.widest_trust, double(r));
+}
+
+}  // namespace
+
+std::vector<float> point_normals(const MpuFunction &mpu, const PointSet &points, Workers &workers,
+                                 Progress &progress) {
+    const Octree &tree = mpu.tree();
+    std::vector<float> out;
+    assign_reporting(out, 3 * points.size(), progress);
+    std::vector<uint32_t> leaves;
+    for (uint32_t i = 0; i < tree.cells.size(); ++i)
+        if (tree.cells[i].is_leaf() && tree.cells[i].point_end > tree.cells[i].point_begin) leaves.push_back(i);
+    parallel_for(0, leaves.size(), workers, progress, [&](size_t l) {
+        const uint32_t cell = leaves[l];
+        const Cell &c = tree.cells[cell];
+        // The leaves blending inside this cell, gathered once for all its points.
+        thread_local std::vector<uint32_t> near;
+        const Eigen::Vector3d half = Eigen::Vector3d::Constant(0.5 * c.size);
+        mpu.gather(Eigen::AlignedBox3d(c.centre - half, c.centre + half), near);
+        Eigen::Vector3d g;
+        for (uint32_t k = c.point_begin; k < c.point_end; ++k) {
+            // A coarse leaf can hold thousands of points: report within it too.
+            if ((k - c.point_begin) % 16 == 15) progress.tick();
+            uint32_t i = tree.order[k];
+            Eigen::Vector3d p = points.point(i);
+            mpu.value_among(near, p, &g);
+            double gn = g.norm();
+            if (!(gn > 1e-12) || !g.allFinite()) {
+                mpu.cell_value(cell, p, &g);  // ∇f vanishes: the oriented local fit
+                gn = g.norm();
+            }
+            Eigen::Vector3d n = gn > 0.0 ? Eigen::Vector3d(-g / gn) : Eigen::Vector3d::UnitZ();
+            for (int d = 0; d < 3; ++d) out[3 * i + d] = float(n[d]);
+        }
+    }, 1);  // leaves come coarsest first: one per chunk
+    progress.throw_if_cancelled();
+    return out;
+}
+
+
+PointMeasures measure_points(const MpuFunction &mpu, const PointSet &points, Workers &workers, Progress &progress) {
+    PointMeasures out;
+    out.normals = point_normals(mpu, points, workers, progress);
+    // Areas and trust radii take no share of the bar: they cost little next to the normals.
+    Progress areas_progress = progress.slice(1.0, 1.0);
+    measure_areas(mpu.tree(), points, workers, areas_progress, out);
+    return out;
+}
+
+}  // namespace gmpu

@@ -1,0 +1,96 @@
+#include "pipeline/reconstruction.hpp"
+
+#include <algorithm>
+
+#include "fit/build_octree.hpp"
+#include "fit/noise_estimate.hpp"
+#include "implicit/mpu_function.hpp"
+#include "mesh/polygonizer.hpp"
+
+namespace gmpu {
+
+namespace {
+
+// The end of a successful stage, before it commits its result: the final report (fraction
+// 1), after which nothing slow follows; a cancel on it counts.
+void finish(Progress &progress) {
+    progress.report(1.0, true);
+    progress.throw_if_cancelled();
+}
+
+}  // namespace
+
+Workers &Reconstruction::workers(unsigned threads) {
+    const unsigned wanted = resolve_threads(threads);
+    if (!workers_ || workers_->requested() != wanted) {
+        workers_.reset();  // its threads end before the new pool's start
+        workers_ = std::make_unique<Workers>(wanted);
+    }
+    return *workers_;
+}
+
+void Reconstruction::discard_fit() {
+    tree = Octree();
+    signs.clear();
+    measures = PointMeasures();
+    winding = WindingField();
+    orient_stats = {};
+}
+
+void Reconstruction::fit(const Params &params, Progress &progress) {
+    Workers &pool = workers(params.threads);
+    progress.report(0.0, true);
+    const double new_noise = estimate_noise(points, progress);
+    const double new_epsilon = effective_epsilon(points, params, new_noise);
+    Octree new_tree = build_octree(points, params, new_epsilon, pool, progress);
+    finish(progress);
+    discard_fit();
+    tree = std::move(new_tree);
+    noise = new_noise;
+    epsilon = new_epsilon;
+}
+
+void Reconstruction::orient(const Params &params, Progress &progress) {
+    Workers &pool = workers(params.threads);
+    progress.report(0.0, true);
+    // The steps' shares of the stage's progress.
+    Progress signs_progress = progress.slice(0.0, 0.9), measures_progress = progress.slice(0.9, 0.95),
+             winding_progress = progress.slice(0.95, 1.0);
+    // The fit is never changed, so a cancelled or failed orient leaves one the next orient
+    // can use as it is.
+    winding = WindingField();
+    Orientation orientation = orient_octree(tree, points, input_normals.empty() ? nullptr : input_normals.data(),
+                                            pool, signs_progress);
+    const MpuFunction mpu(tree, orientation.signs, 0);
+    measures = measure_points(mpu, points, pool, measures_progress);
+    winding = WindingField(tree, points, measures.normals, measures.area, &winding_progress);
+    finish(progress);
+    signs = std::move(orientation.signs);
+    orient_stats = orientation.stats;
+}
+
+Mesh Reconstruction::polygonize(const Params &params, int resolution, Progress &progress) {
+    Workers &pool = workers(params.threads);
+    progress.report(0.0, true);
+    Mesh mesh = gmpu::polygonize(field(params.level), resolution, params, pool, progress);
+    return mesh;  // the caller checks it and makes the final report
+}
+
+void Reconstruction::evaluate(const Params &params, const double *xyz, size_t count, double *values,
+                              double *gradients) const {
+    const SurfaceField f = field(params.level);
+    const Normalisation &norm = points.normalisation();
+    Eigen::Vector3d g;
+    for (size_t i = 0; i < count; ++i) {
+        Eigen::Vector3d q = norm.to_unit(Eigen::Vector3d(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]));
+        // A finite query can normalise to inf (1e300 against a cloud at 1e-30), and f and
+        // ∇f would be inf and NaN. Beyond 1e15 box lengths f is the far value anyway.
+        q = q.cwiseMax(-1e15).cwiseMin(1e15);
+        double v = f.value(q, gradients ? &g : nullptr);
+        if (values) values[i] = v / norm.scale;
+        if (gradients)
+            for (int d = 0; d < 3; ++d) gradients[3 * i + d] = g[d];
+    }
+}
+
+}  // namespace gmpu

@@ -1,0 +1,67 @@
+// One reconstruction's state and its stages: the point set, the fitted tree, the oriented
+// point measures, the winding field, and the worker threads every stage's loops share.
+// Each stage computes into locals and commits only once it has completed (its final
+// report included), so a cancelled or failed stage leaves the previous stage's result as
+// it was. The C ABI (lib/api/surface_api.cpp) checks arguments, converts inputs and keeps
+// the stage order; this is where the stages are run.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "core/parallel.hpp"
+#include "core/params.hpp"
+#include "core/progress.hpp"
+#include "geometry/point_set.hpp"
+#include "implicit/surface_field.hpp"
+#include "implicit/winding_field.hpp"
+#include "mesh/mesh.hpp"
+#include "model/octree.hpp"
+#include "orient/orient.hpp"
+
+namespace gmpu {
+
+struct Reconstruction {
+    PointSet points;                       // the input points less the outliers
+    size_t input_count = 0;                // points given, outliers included
+    std::vector<uint32_t> outliers;        // input indices set aside, increasing
+    std::vector<uint32_t> outlier_nearest; // per outlier: the nearest kept point
+    std::vector<float> input_normals;      // unit, 3 per kept point; empty when none were given
+    Octree tree;                           // fit's result, never changed after
+    CellSigns signs;                       // orient's result: one label per cell of the tree
+    PointMeasures measures;                // orient's: oriented normals, areas, trust radii per point
+    WindingField winding;                  // built from the measures; signs far regions
+    OrientStats orient_stats;
+    double noise = 0.0, epsilon = 0.0;     // of the last fit, normalised units
+
+    // Fit: noise estimate, ε, adaptive octree of local fits.
+    void fit(const Params &params, Progress &progress);
+    // Orient: cell signs, oriented point normals and measures, winding field.
+    void orient(const Params &params, Progress &progress);
+    // The mesh of the zero set at `resolution` (polygonizer.hpp: default_resolution).
+    Mesh polygonize(const Params &params, int resolution, Progress &progress);
+    // f and ∇f (world frame values, unit-free gradients) at `count` world points; either
+    // output may be null. Requires an oriented reconstruction.
+    void evaluate(const Params &params, const double *xyz, size_t count, double *values, double *gradients) const;
+
+    // The surface field of the oriented reconstruction, blended down to `level` (0: the
+    // leaves): the one field evaluate and polygonize both ask. A view: valid while this
+    // reconstruction is not changed.
+    SurfaceField field(int level) const {
+        return SurfaceField(MpuFunction(tree, signs, level), points, measures, winding);
+    }
+
+    // Forget fit and orient (the points stay).
+    void discard_fit();
+
+    // The worker pool for `threads` (0: one per core): kept across stages, rebuilt only when
+    // the count asked for changes.
+    Workers &workers(unsigned threads);
+
+private:
+    std::unique_ptr<Workers> workers_;
+};
+
+}  // namespace gmpu
