@@ -7,7 +7,7 @@
  *                    [--noise-scale S] [--max-memory BYTES]
  *                    [--use-normals] [--sharp] [--quiet] [--version]
  *
- * Output format from the extension (.ply, .obj, .off). Exit status 0 on success, 1 on a
+ * Output format from the extension (.ply, .obj, .off, .stl, .glb). Exit status 0 on success, 1 on a
  * failure (one line on stderr), 2 on bad usage. The outputs are checked before any work
  * and replaced only once all of them are written (cli/staged_output.h).
  */
@@ -36,7 +36,7 @@ static const char *usage =
     "                        [--noise-scale S] [--max-memory BYTES]\n"
     "                        [--use-normals] [--sharp] [--quiet] [--version]\n"
     "  INPUT   .ply .xyz .txt .off .obj point cloud (normals ignored unless --use-normals)\n"
-    "  OUTPUT  .ply .obj .off mesh (closed, outward-facing)\n"
+    "  OUTPUT  .ply .obj .off .stl .glb mesh (closed, outward-facing)\n"
     "  Options take their value as the next argument or after '=' (--resolution=64).\n"
     "  A file name starting with '-' must be written ./-name.\n";
 

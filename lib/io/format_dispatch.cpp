@@ -17,17 +17,18 @@ namespace detail {
 
 namespace {
 
-enum class Format { ply, xyz, off, obj };
+enum class Format { ply, xyz, off, obj, stl, glb };
 
 // What each entry point accepts, for lookup and for the error message.
 struct Accepts {
     const char *purpose;
     const char *list;  // for the message
     bool ply, xyz, off, obj;
+    bool stl_glb = false;  // binary STL and glTF: written, never read
 };
 constexpr Accepts reading_points{"reading points", ".ply, .xyz, .txt, .off, .obj", true, true, true, true};
 constexpr Accepts reading_meshes{"reading meshes", ".ply, .off, .obj", true, false, true, true};
-constexpr Accepts writing_meshes{"writing meshes", ".ply, .obj, .off", true, false, true, true};
+constexpr Accepts writing_meshes{"writing meshes", ".ply, .obj, .off, .stl, .glb", true, false, true, true, true};
 constexpr Accepts writing_points{"writing points", ".ply, .xyz", true, true, false, false};
 
 // Lower-cased extension of the file name (without the dot), "" when it has none.
@@ -46,6 +47,8 @@ Format format_of(const std::string &path, const Accepts &a) {
     if (a.xyz && (ext == "xyz" || (ext == "txt" && &a == &reading_points))) return Format::xyz;
     if (a.off && ext == "off") return Format::off;
     if (a.obj && ext == "obj") return Format::obj;
+    if (a.stl_glb && ext == "stl") return Format::stl;
+    if (a.stl_glb && ext == "glb") return Format::glb;
     fail(GMPU_ERROR_UNSUPPORTED, path,
          (ext.empty() ? std::string("no file extension") : "unsupported extension '." + ext + "'") + " for " +
              a.purpose + " (expected " + a.list + ")");
@@ -87,7 +90,9 @@ Parsed parse(Format f, InputFile &file, const std::string &path, Want want) {
         case Format::xyz: return parse_xyz_lines(lines, path, line_count);
         case Format::off: return parse_off_lines(lines, path, want);
         case Format::obj: return parse_obj_lines(lines, path, want, line_count);
-        case Format::ply: break;
+        case Format::ply:
+        case Format::stl:
+        case Format::glb: break;  // PLY is read above; STL and glTF are never read
     }
     fail(GMPU_ERROR_INTERNAL, path, "unknown format");
 }
@@ -171,6 +176,8 @@ void write_mesh(const std::string &path, const MeshView &mesh) {
         case detail::Format::ply: detail::write_ply(out, mesh, true); break;
         case detail::Format::obj: detail::write_obj(out, mesh); break;
         case detail::Format::off: detail::write_off(out, mesh); break;
+        case detail::Format::stl: detail::write_stl(out, mesh); break;
+        case detail::Format::glb: detail::write_glb(out, mesh); break;
         case detail::Format::xyz: break;  // not accepted for meshes
     }
     out.commit();
