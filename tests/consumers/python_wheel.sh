@@ -41,7 +41,8 @@ PY
 # 1. pip install from the clone.
 /usr/bin/python3 -m venv --system-site-packages "$work/venv"
 (cd "$work/gmpu" && "${clean_env[@]}" "$work/venv/bin/pip" install --quiet --no-build-isolation .)
-echo "python_wheel: pip install: $(check_venv "$work/venv")"
+out=$(check_venv "$work/venv")
+echo "python_wheel: pip install: $out"
 
 # 2. sdist and wheel; the wheel into a fresh venv.
 (cd "$work/gmpu" && "${clean_env[@]}" /usr/bin/python3 -m build --no-isolation --outdir "$work/dist" . >/dev/null)
@@ -51,4 +52,5 @@ wheel=$(ls "$work"/dist/gmpu-*.whl)
     { echo "python_wheel: $wheel holds no gmpu/libgmpu.so.1" >&2; exit 1; }
 /usr/bin/python3 -m venv --system-site-packages "$work/venv2"
 "${clean_env[@]}" "$work/venv2/bin/pip" install --quiet "$wheel"
-echo "python_wheel: python3 -m build: $(basename "$wheel"): $(check_venv "$work/venv2")"
+out=$(check_venv "$work/venv2")
+echo "python_wheel: python3 -m build: $(basename "$wheel"): $out"

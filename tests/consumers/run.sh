@@ -1,6 +1,6 @@
 #!/bin/bash
 # Builds consumer.c against an installed gmpu every way a user would, and runs each program:
-#   shared   cc ... $(pkg-config --cflags --libs gmpu) -Wl,-rpath,LIBDIR;
+#   shared   cc ... $(pkg-config --cflags --libs gmpu) -Wl,-rpath,$(pkg-config --variable=libdir gmpu);
 #   static   cc -static ... $(pkg-config --static --cflags --libs gmpu): Libs.private complete;
 #   cmake    find_package(gmpu) -> gmpu::gmpu and gmpu::gmpu_static;
 #   meson    gmpu as a subproject (subprojects/gmpu -> this source tree), dependency('gmpu').
@@ -55,7 +55,7 @@ for way in "${ways[@]}"; do
             echo "consumers: gmpu.pc leaks a private dependency into Cflags: $cflags" >&2
             exit 1
         fi
-        cc -o "$work/shared" "$here/consumer.c" $(pc --cflags --libs) -lm -Wl,-rpath,"$lib"
+        cc -o "$work/shared" "$here/consumer.c" $(pc --cflags --libs) -lm -Wl,-rpath,"$(pc --variable=libdir)"
         check_run shared "$work/shared"
         ;;
     static)
