@@ -54,6 +54,8 @@ fn links_statically(dir: &str) -> bool {
 /// Links libgmpu from `dir`: statically when libgmpu.a is there (unless GMPU_LINK=dylib).
 fn link_gmpu(dir: &str) {
     if links_statically(dir) {
+        // The archive is copied into every binary: a rebuilt one must relink them.
+        println!("cargo:rerun-if-changed={dir}/libgmpu.a");
         println!("cargo:rustc-link-search=native={dir}");
         println!("cargo:rustc-link-lib=static=gmpu");
         // The archive's C++ objects need the C++ runtime (Rust's std links libm and pthread).

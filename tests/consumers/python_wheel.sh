@@ -45,7 +45,8 @@ out=$(check_venv "$work/venv")
 echo "python_wheel: pip install: $out"
 
 # 2. sdist and wheel; the wheel into a fresh venv.
-(cd "$work/gmpu" && "${clean_env[@]}" /usr/bin/python3 -m build --no-isolation --outdir "$work/dist" . >/dev/null)
+(cd "$work/gmpu" && "${clean_env[@]}" /usr/bin/python3 -m build --no-isolation --outdir "$work/dist" . \
+    >"$work/build.log" 2>&1) || { cat "$work/build.log" >&2; exit 1; }
 ls "$work"/dist/gmpu-*.tar.gz >/dev/null
 wheel=$(ls "$work"/dist/gmpu-*.whl)
 /usr/bin/python3 -m zipfile -l "$wheel" | grep -q 'gmpu/libgmpu\.so\.1 ' ||
