@@ -49,8 +49,11 @@ echo "python_wheel: pip install: $out"
     >"$work/build.log" 2>&1) || { cat "$work/build.log" >&2; exit 1; }
 ls "$work"/dist/gmpu-*.tar.gz >/dev/null
 wheel=$(ls "$work"/dist/gmpu-*.whl)
-/usr/bin/python3 -m zipfile -l "$wheel" | grep -q 'gmpu/libgmpu\.so\.1 ' ||
-    { echo "python_wheel: $wheel holds no gmpu/libgmpu.so.1" >&2; exit 1; }
+/usr/bin/python3 - "$wheel" <<'PY'
+import sys, zipfile
+names = zipfile.ZipFile(sys.argv[1]).namelist()
+assert "gmpu/libgmpu.so.1" in names, f"{sys.argv[1]} holds no gmpu/libgmpu.so.1: {names}"
+PY
 /usr/bin/python3 -m venv --system-site-packages "$work/venv2"
 "${clean_env[@]}" "$work/venv2/bin/pip" install --quiet "$wheel"
 out=$(check_venv "$work/venv2")
