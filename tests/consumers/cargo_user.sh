@@ -36,7 +36,7 @@ fn main() -> Result<(), gmpu::Error> {
 RUST
 "${clean_env[@]}" cargo build --offline --quiet
 binary=$work/target/debug/my_app
-if readelf -d "$binary" | grep -q 'NEEDED.*libgmpu'; then
+if [[ $(readelf -d "$binary") == *NEEDED*libgmpu* ]]; then
     echo "cargo_user: the binary needs libgmpu.so; expected it linked statically" >&2
     exit 1
 fi

@@ -60,7 +60,7 @@ for way in "${ways[@]}"; do
         ;;
     static)
         cc -static -o "$work/static" "$here/consumer.c" $(pc --static --cflags --libs) -lm
-        if readelf -d "$work/static" | grep -q NEEDED; then
+        if [[ $(readelf -d "$work/static") == *NEEDED* ]]; then
             echo "consumers: the -static program still needs shared libraries" >&2
             exit 1
         fi
@@ -73,7 +73,7 @@ for way in "${ways[@]}"; do
         cmake --build "$work/cmake/build" >/dev/null
         check_run cmake-shared "$work/cmake/build/consumer_shared"
         check_run cmake-static "$work/cmake/build/consumer_static"
-        if readelf -d "$work/cmake/build/consumer_static" | grep -q 'NEEDED.*libgmpu'; then
+        if [[ $(readelf -d "$work/cmake/build/consumer_static") == *NEEDED*libgmpu* ]]; then
             echo "consumers: gmpu::gmpu_static linked the shared library" >&2
             exit 1
         fi
