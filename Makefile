@@ -12,7 +12,8 @@ DEMO_OUT := $(BUILD)/demo/bunny_mesh.ply
 # Debian packages each target needs; `deps-*` installs only the missing ones.
 CORE_PKGS := g++ pkg-config meson ninja-build libeigen3-dev libnanoflann-dev libcmocka-dev libmeshoptimizer-dev
 TEST_PKGS := $(CORE_PKGS) python3-cffi python3-numpy python3-pytest python3-matplotlib \
-             valgrind clang libclang-rt-14-dev time
+             valgrind clang libclang-rt-14-dev time python3-open3d \
+             cmake python3-venv python3-mesonpy python3-build
 BENCH_PKGS := $(TEST_PKGS) python3-open3d libcgal-dev libgmp-dev libmpfr-dev time
 
 define apt_install
@@ -24,7 +25,7 @@ define apt_install
 	fi
 endef
 
-.PHONY: all deps deps-test deps-bench build demo test test-c test-python test-node test-rust \
+.PHONY: all deps deps-test deps-bench build demo test test-c test-python test-node test-rust test-consumers \
         test-sanitize bench bench-quick bench-corpus fuzz clean plugins deps-plugins test-plugins \
         plugin-screenshots
 
@@ -59,7 +60,8 @@ demo: build
 	@echo "Oriented points written to $(abspath $(BUILD)/demo/bunny_oriented_points.ply)"
 
 test: deps-test build
-	$(MAKE) --no-print-directory test-c test-load test-python test-node test-rust test-plugins test-sanitize test-tsan test-valgrind fuzz-quick
+	$(MAKE) --no-print-directory test-c test-load test-python test-node test-rust test-plugins test-consumers \
+	  test-sanitize test-tsan test-valgrind fuzz-quick
 
 test-c: build
 	meson test -C $(BUILD) --print-errorlogs
@@ -75,7 +77,16 @@ test-node: build
 test-rust: build
 	@command -v cargo >/dev/null || { echo "test-rust: cargo not found (Rust >= 1.77 is needed)"; exit 1; }
 	cd bindings/rust && GMPU_LIBRARY=$(abspath $(BUILD))/lib/libgmpu.so.1 cargo test --offline
+	tests/consumers/cargo_user.sh
 	$(MAKE) --no-print-directory test-cross
+
+# Programs on an installed gmpu, built the ways the README's install section shows: C through
+# pkg-config (shared, static), CMake and a meson subproject; the Python package through pip
+# and python3 -m build (from a clone: the committed files) in fresh venvs.
+.PHONY: test-consumers
+test-consumers: build
+	tests/consumers/run.sh $(BUILD)
+	tests/consumers/python_wheel.sh
 
 # Same input and parameters -> same mesh in C, Python, Node and Rust (tests/cross/).
 .PHONY: test-cross

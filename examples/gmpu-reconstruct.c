@@ -11,7 +11,7 @@
  * --param sets any parameter of the library's table by name (gmpu_param_key); --help lists
  * them all with their defaults and ranges (gmpu_param_info).
  *
- * Output format from the extension (.ply, .obj, .off). Exit status 0 on success, 1 on a
+ * Output format from the extension (.ply, .obj, .off, .stl, .glb). Exit status 0 on success, 1 on a
  * failure (one line on stderr), 2 on bad usage. The outputs are checked before any work
  * and replaced only once all of them are written (cli/staged_output.h).
  */
@@ -61,7 +61,7 @@ static const char *usage =
     "                        [--use-normals] [--sharp] [--keep-outliers] [--quiet] [--version]\n"
     "                        [--trim[=T]] [--target-triangles N] [--target-error E]\n"
     "  INPUT   .ply .xyz .txt .off .obj point cloud (normals ignored unless --use-normals)\n"
-    "  OUTPUT  .ply .obj .off mesh (closed, outward-facing; .ply with a per-vertex confidence)\n"
+    "  OUTPUT  .ply .obj .off .stl .glb mesh (closed, outward-facing; .ply with a per-vertex confidence)\n"
     "  --keep-outliers fits the outliers found (points far from all others) too; by default\n"
     "  they are reported and set aside.\n"
     "  --trim[=T]  remove surface farther than T sample spacings from every point (default 3):\n"

@@ -1,3 +1,4 @@
+/// <reference lib="esnext.disposable" />
 // Type declarations for the `gmpu` package (index.js). The C ABI behind it is
 // include/gmpu/gmpu.h; every function here documents which C call it makes.
 
@@ -250,6 +251,10 @@ export declare class Surface {
      * (Also available as [Symbol.dispose] where the runtime has it.)
      */
     close(): void;
+    /** close(), for `using surface = new Surface(...)`. */
+    [Symbol.dispose](): void;
+    /** close(), for `await using`: an async stage still running is cancelled. */
+    [Symbol.asyncDispose](): Promise<void>;
 }
 
 /** Points → fit → orient → polygonize in one call; the native surface is always freed. */

@@ -626,6 +626,11 @@ if (typeof Symbol.dispose === 'symbol') {
         this.close();
     };
 }
+if (typeof Symbol.asyncDispose === 'symbol') {
+    Surface.prototype[Symbol.asyncDispose] = async function asyncDispose() {
+        this.close();
+    };
+}
 
 function applyOptions(surface, options, extra) {
     if (options === null || typeof options !== 'object') throw invalidArgument('options must be an object');

@@ -7,8 +7,13 @@
 //!      PKG_CONFIG_PATH is honoured);
 //!   3. the meson build directory of this source tree, `../../build/lib`.
 //!
-//! Every directory found this way is also put in the rpath of the crate's tests, examples
-//! and binaries, so they run without LD_LIBRARY_PATH.
+//! When that directory holds the static library (libgmpu.a: meson builds and installs it
+//! beside libgmpu.so), it is linked statically, with the C++ runtime it needs, so every
+//! program that depends on this crate, a user's own binary included, runs with no
+//! environment variables and no rpath. (An rpath set here would reach only this package's
+//! own tests and examples: cargo:rustc-link-arg does not apply to dependents.)
+//! GMPU_LINK=dylib links libgmpu.so instead; the crate's tests and examples then get an
+//! rpath to it.
 use std::env;
 use std::fs;
 use std::path::{Path, PathBuf};
@@ -42,6 +47,26 @@ fn pkg_config() -> Option<(Vec<String>, Vec<String>)> {
     Some((dirs, libs))
 }
 
+fn links_statically(dir: &str) -> bool {
+    let want_dylib = env::var("GMPU_LINK").map(|v| v == "dylib").unwrap_or(false);
+    !want_dylib && Path::new(dir).join("libgmpu.a").exists()
+}
+
+/// Links libgmpu from `dir`: statically when libgmpu.a is there (unless GMPU_LINK=dylib).
+fn link_gmpu(dir: &str) {
+    if links_statically(dir) {
+        // The archive is copied into every binary: a rebuilt one must relink them.
+        println!("cargo:rerun-if-changed={dir}/libgmpu.a");
+        println!("cargo:rustc-link-search=native={dir}");
+        println!("cargo:rustc-link-lib=static=gmpu");
+        // The archive's C++ objects need the C++ runtime (Rust's std links libm and pthread).
+        println!("cargo:rustc-link-lib=dylib=stdc++");
+        return;
+    }
+    link_dir(dir);
+    println!("cargo:rustc-link-lib=dylib=gmpu");
+}
+
 fn link_dir(dir: &str) {
     println!("cargo:rustc-link-search=native={dir}");
     // rpath for everything this package links (tests, examples, binaries); a dependent crate
@@ -54,6 +79,7 @@ fn link_dir(dir: &str) {
 fn find_library() {
     println!("cargo:rerun-if-env-changed=GMPU_LIBRARY");
     println!("cargo:rerun-if-env-changed=GMPU_LIB_DIR");
+    println!("cargo:rerun-if-env-changed=GMPU_LINK");
     println!("cargo:rerun-if-env-changed=PKG_CONFIG_PATH");
     println!("cargo:rerun-if-env-changed=PKG_CONFIG");
     let manifest = PathBuf::from(env::var("CARGO_MANIFEST_DIR").unwrap());
@@ -83,13 +109,17 @@ fn find_library() {
         }
         let dir = dir.canonicalize().unwrap_or(dir);
         let d = dir.to_string_lossy().into_owned();
-        link_dir(&d);
+        link_gmpu(&d);
         println!("cargo:root={d}");
-        println!("cargo:rustc-link-lib=dylib=gmpu");
         return;
     }
 
     if let Some((dirs, libs)) = pkg_config() {
+        if let Some(d) = dirs.iter().find(|d| links_statically(d)) {
+            link_gmpu(d);
+            println!("cargo:root={d}");
+            return;
+        }
         for d in &dirs {
             link_dir(d);
         }
@@ -107,9 +137,8 @@ fn find_library() {
     if has_library(&build) {
         let dir = build.canonicalize().unwrap_or(build);
         let d = dir.to_string_lossy().into_owned();
-        link_dir(&d);
+        link_gmpu(&d);
         println!("cargo:root={d}");
-        println!("cargo:rustc-link-lib=dylib=gmpu");
         return;
     }
 

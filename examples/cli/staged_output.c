@@ -46,7 +46,9 @@ static void extension_of(const char *path, char *ext, size_t size) {
 
 /* The same lists as the library's writers (lib/io/format_dispatch.cpp). */
 static int known_extension(output_kind kind, const char *ext) {
-    if (kind == OUTPUT_MESH) return !strcmp(ext, "ply") || !strcmp(ext, "obj") || !strcmp(ext, "off");
+    if (kind == OUTPUT_MESH)
+        return !strcmp(ext, "ply") || !strcmp(ext, "obj") || !strcmp(ext, "off") || !strcmp(ext, "stl") ||
+               !strcmp(ext, "glb");
     return !strcmp(ext, "ply") || !strcmp(ext, "xyz");
 }
 
@@ -98,7 +100,7 @@ int output_prepare(staged_output *out, const char *given, output_kind kind, cons
     char ext[16];
     extension_of(given, ext, sizeof ext);
     if (!known_extension(kind, ext)) {
-        const char *list = kind == OUTPUT_MESH ? ".ply, .obj, .off" : ".ply, .xyz";
+        const char *list = kind == OUTPUT_MESH ? ".ply, .obj, .off, .stl, .glb" : ".ply, .xyz";
         if (ext[0])
             say(msg, msg_size, "%s: GMPU_ERROR_UNSUPPORTED: %s: unsupported extension '.%s' (expected %s)",
                 doing(kind), given, ext, list);

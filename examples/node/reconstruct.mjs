@@ -1,29 +1,32 @@
 #!/usr/bin/env node
 // reconstruct.mjs — unoriented point cloud in, watertight oriented mesh out (Node.js).
 //
-//   node reconstruct.mjs INPUT OUTPUT [--normals-out POINTS.ply] [--error E] [--max-depth D]
-//                        [--resolution R] [--level L] [--threads T] [--no-sharp] [--quiet]
+//   node reconstruct.mjs INPUT -o OUTPUT [--normals-out POINTS.ply] [--error E] [--max-depth D]
+//                        [--resolution R] [--level L] [--threads T] [--noise-scale S]
+//                        [--max-memory BYTES] [--sharp] [--quiet]
 //
-// The Node twin of the C CLI build/examples/gmpu-reconstruct: same defaults, so the same
-// input gives the same mesh. INPUT: .ply .xyz .txt .off .obj; OUTPUT: .ply .obj .off.
+// The Node twin of the C CLI build/examples/gmpu-reconstruct: the same flags and defaults, so
+// the same command line gives the same mesh. INPUT: .ply .xyz .txt .off .obj; OUTPUT: .ply
+// .obj .off .stl .glb.
 // Exit status 0 on success, 1 on a failure (one line on stderr), 2 on bad usage.
 import { parseArgs } from 'node:util';
 
 import { GmpuError, readPoints, Surface, writeMesh, writePoints } from 'gmpu';
 
-const usage = `usage: node reconstruct.mjs INPUT OUTPUT [--normals-out POINTS.ply] [--error E]
+const usage = `usage: node reconstruct.mjs INPUT -o OUTPUT [--normals-out POINTS.ply] [--error E]
                           [--max-depth D] [--resolution R] [--level L] [--threads T]
-                          [--no-sharp] [--quiet]`;
+                          [--noise-scale S] [--max-memory BYTES] [--sharp] [--quiet]`;
 
 function parse() {
-    const numeric = ['error', 'max-depth', 'resolution', 'level', 'threads'];
+    const numeric = ['error', 'max-depth', 'resolution', 'level', 'threads', 'noise-scale', 'max-memory'];
     let parsed;
     try {
         parsed = parseArgs({
             allowPositionals: true,
             options: {
+                output: { type: 'string', short: 'o' },
                 'normals-out': { type: 'string' },
-                'no-sharp': { type: 'boolean' },
+                sharp: { type: 'boolean' },
                 quiet: { type: 'boolean', short: 'q' },
                 help: { type: 'boolean', short: 'h' },
                 ...Object.fromEntries(numeric.map((name) => [name, { type: 'string' }])),
@@ -34,7 +37,8 @@ function parse() {
     }
     const { values, positionals } = parsed;
     if (values.help) return { help: true };
-    if (positionals.length !== 2) return { problem: positionals.length < 2 ? 'missing INPUT or OUTPUT' : `unexpected argument '${positionals[2]}'` };
+    if (positionals.length !== 1) return { problem: positionals.length < 1 ? 'missing INPUT' : `unexpected argument '${positionals[1]}'` };
+    if (values.output === undefined) return { problem: 'missing -o OUTPUT' };
     const options = {};
     const camel = (name) => name.replace(/-(\w)/g, (_, c) => c.toUpperCase());
     for (const name of numeric) {
@@ -43,8 +47,8 @@ function parse() {
         if (values[name].trim() === '' || !Number.isFinite(v)) return { problem: `--${name} needs a number, got '${values[name]}'` };
         options[camel(name)] = v;
     }
-    if (values['no-sharp']) options.sharpFeatures = false;
-    return { input: positionals[0], output: positionals[1], normalsOut: values['normals-out'], quiet: !!values.quiet, options };
+    if (values.sharp) options.sharpFeatures = true;  // as the C CLI: otherwise the library's default
+    return { input: positionals[0], output: values.output, normalsOut: values['normals-out'], quiet: !!values.quiet, options };
 }
 
 const args = parse();

@@ -130,6 +130,8 @@ constexpr FormatRow kFormats[] = {
     {"obj", nullptr, read_obj, read_obj, write_obj, nullptr},
     {"off", nullptr, read_off, read_off, write_off, nullptr},
     {"xyz", "txt", read_xyz, nullptr, nullptr, write_xyz},
+    {"stl", nullptr, nullptr, nullptr, write_stl, nullptr},  // binary STL, written only
+    {"glb", nullptr, nullptr, nullptr, write_glb, nullptr},  // glTF 2.0 binary, written only
 };
 
 // The roles a format can play, for lookup and for the error message.

@@ -60,6 +60,8 @@ void write_ply(AtomicFile &out, const MeshView &mesh, bool faces);
 void write_obj(AtomicFile &out, const MeshView &mesh);
 void write_off(AtomicFile &out, const MeshView &mesh);
 void write_xyz(AtomicFile &out, const double *xyz, const double *normals, size_t count);
+void write_stl(AtomicFile &out, const MeshView &mesh);  // binary; face normals from the triangles
+void write_glb(AtomicFile &out, const MeshView &mesh);  // glTF 2.0 binary; vertex normals when given
 
 // The polygon of `count` vertex indices (already range-checked) as a triangle fan.
 inline void append_fan(std::vector<uint32_t> &triangles, const uint32_t *polygon, size_t count) {

@@ -66,7 +66,8 @@ PointCloud read_points(const std::string &path, const ReadOptions &options = {})
 // Vertices and faces of .off, .obj or .ply meshes (used by tests and the benchmark).
 MeshData read_mesh(const std::string &path);
 
-// .ply (binary little-endian, with per-vertex normals when given), .obj, .off.
+// .ply (binary little-endian, with per-vertex normals when given), .obj, .off, .stl
+// (binary, face normals), .glb (glTF 2.0 binary, float32, vertex normals when given).
 void write_mesh(const std::string &path, const MeshView &mesh);
 
 // .ply (binary little-endian; nx ny nz when normals is non-null) or .xyz (ascii).

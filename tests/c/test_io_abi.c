@@ -377,7 +377,7 @@ static void test_mesh_write(void **state) {
     mkdir(scratch_path("w"), 0755);
     check_failure(gmpu_mesh_write(NULL, scratch_path("w/a.ply")), GMPU_ERROR_INVALID_ARGUMENT, "mesh is NULL");
     check_failure(gmpu_mesh_write(m, NULL), GMPU_ERROR_INVALID_ARGUMENT, "path is NULL");
-    check_failure(gmpu_mesh_write(m, scratch_path("w/a.stl")), GMPU_ERROR_UNSUPPORTED, "'.stl'");
+    check_failure(gmpu_mesh_write(m, scratch_path("w/a.wrl")), GMPU_ERROR_UNSUPPORTED, "'.wrl'");
     check_failure(gmpu_mesh_write(m, scratch_path("w/a.xyz")), GMPU_ERROR_UNSUPPORTED, "'.xyz'");
     const char *deep = scratch_path("w/missing/a.obj");
     check_failure(gmpu_mesh_write(m, deep), GMPU_ERROR_IO, deep);

@@ -420,11 +420,11 @@ static void test_outputs(void **state) {
     run_result r = run_cli(a1);
     check_run(&r, 1, "No such file or directory");
     assert_non_null(strstr(r.err, "out.ply"));
-    const char *stl = scratch_path("out.stl");
-    const char *a2[] = {in, "-o", stl, "--quiet", "--resolution", "24", NULL};
+    const char *wrl = scratch_path("out.wrl");
+    const char *a2[] = {in, "-o", wrl, "--quiet", "--resolution", "24", NULL};
     r = run_cli(a2);
-    check_run(&r, 1, "'.stl'");
-    assert_false(exists(stl));
+    check_run(&r, 1, "'.wrl'");
+    assert_false(exists(wrl));
     /* An existing output survives a failed run untouched. */
     const char *out = scratch_path("out.ply");
     put_text(out, "previous result");
@@ -451,7 +451,7 @@ static void test_outputs(void **state) {
     check_run(&r, 1, "has no normals");
     assert_false(exists(off));
     /* Without --quiet, a failure after the progress lines still ends with its one line. */
-    const char *a6[] = {in, "-o", stl, "--resolution", "24", NULL};
+    const char *a6[] = {in, "-o", wrl, "--resolution", "24", NULL};
     r = run_cli(a6);
     assert_int_equal(r.status, 1);
     const char *last = r.err + strlen(r.err) - 1;
@@ -609,7 +609,7 @@ static void test_older_output_and_same_file(void **state) {
     assert_false(exists(fresh));
     /* Output checks happen before the input is even read: a bad directory, a directory as
      * the output, an unknown extension all fail with one line and no progress. */
-    const char *bad[] = {scratch_path("no/such/dir/m.ply"), scratch_dir, scratch_path("m.stl"),
+    const char *bad[] = {scratch_path("no/such/dir/m.ply"), scratch_dir, scratch_path("m.wrl"),
                          scratch_path("keep-sphere.xyz")};
     for (size_t k = 0; k < sizeof bad / sizeof *bad; ++k) {
         const char *a4[] = {in, "-o", bad[k], "--resolution", "24", NULL};

@@ -12,7 +12,7 @@ is missing FAILS, by name; nothing is skipped.
 The programs (run from the repository root):
     C       build/examples/gmpu-reconstruct IN -o OUT FLAGS
     Python  /usr/bin/python3 examples/python/reconstruct.py IN OUT FLAGS   (PYTHONPATH=bindings/python)
-    Node    node examples/node/reconstruct.mjs IN OUT FLAGS
+    Node    node examples/node/reconstruct.mjs IN -o OUT FLAGS
     Rust    cargo run --offline --example reconstruct (bindings/rust) -- IN OUT FLAGS
 Every binding is pointed at the same library, BUILD/lib/libgmpu.so.1 (GMPU_LIBRARY for
 Python, Node and the Rust crate; the C CLI has it in its RUNPATH).
@@ -263,7 +263,7 @@ def command(lang: str, build: str, src: str, out: str) -> Tuple[Optional[List[st
             return None, env, script
         if not node:
             return None, env, "the node executable"
-        return [node, script, src, out] + FLAGS, env, ""
+        return [node, script, src, "-o", out] + FLAGS, env, ""
     if lang == "rust":
         manifest = os.path.join(ROOT, "bindings", "rust", "Cargo.toml")
         cargo = shutil.which("cargo")

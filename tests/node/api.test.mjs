@@ -136,6 +136,17 @@ async function inTheBackground(points: Float64Array): Promise<Mesh> {
 }
 export { inTheBackground };
 
+// Explicit resource management: the surface is closed when the scope ends.
+function scoped(points: Float64Array): number {
+    using t = new Surface(points);
+    return t.pointCount;
+}
+async function scopedAsync(points: Float64Array): Promise<Mesh> {
+    await using t = new Surface(points);
+    return (await (await t.fitAsync()).orientAsync()).polygonizeAsync();
+}
+export { scoped, scopedAsync };
+
 const cloud = readPoints(new URL('file:///tmp/cloud.ply'));
 const mesh: Mesh = reconstruct(cloud.positions, { resolution: 64, sharpFeatures: false,
     onProgress: (stage: Stage, fraction: number) => fraction < 1 || stage !== 'polygonize' });

@@ -148,7 +148,7 @@ test('bad paths: missing, unsupported, malformed, unwritable', (t) => {
     assert.throws(() => gmpu.readPoints(broken), gmpuError('GMPU_ERROR_PARSE'));
     const mesh = { vertices: [[0, 0, 0], [1, 0, 0], [0, 1, 0]], faces: [[0, 1, 2]] };
     assert.throws(() => gmpu.writeMesh(path.join(dir, 'no', 'such', 'dir.ply'), mesh), gmpuError('GMPU_ERROR_IO', /No such file/));
-    assert.throws(() => gmpu.writeMesh(path.join(dir, 'mesh.stl'), mesh), gmpuError('GMPU_ERROR_UNSUPPORTED', /\.stl/));
+    assert.throws(() => gmpu.writeMesh(path.join(dir, 'mesh.wrl'), mesh), gmpuError('GMPU_ERROR_UNSUPPORTED', /\.wrl/));
     assert.throws(() => gmpu.writeMesh(path.join(dir, 'mesh.ply'), { ...mesh, faces: [[0, 1, 3]] }),
         gmpuError('GMPU_ERROR_INVALID_INPUT', /triangle 0/));
     assert.throws(() => gmpu.writeMesh(path.join(dir, 'mesh.ply'), { ...mesh, faces: [[0, -1, 2]] }),

@@ -23,7 +23,7 @@ const RESOLUTION = '48';
 test('reconstruct.mjs: same mesh and oriented points as the C CLI with the same options', (t) => {
     const dir = tempDir(t);
     const out = path.join(dir, 'node.ply'), normals = path.join(dir, 'node_points.ply');
-    const r = runExample('reconstruct.mjs', [samplePly, out, '--resolution', RESOLUTION, '--normals-out', normals]);
+    const r = runExample('reconstruct.mjs', [samplePly, '-o', out, '--resolution', RESOLUTION, '--normals-out', normals]);
     assert.equal(r.status, 0, r.stderr);
     assert.match(r.stderr, /gmpu: fit\.\.\.\ngmpu: orient\.\.\.\ngmpu: polygonize\.\.\./);
     assert.match(r.stderr, /35000 points/);
@@ -44,13 +44,18 @@ test('reconstruct.mjs: usage errors exit 2, failures exit 1 with the C message',
     let r = runExample('reconstruct.mjs', [samplePly]);
     assert.equal(r.status, 2);
     assert.match(r.stderr, /usage:/);
-    r = runExample('reconstruct.mjs', [samplePly, path.join(dir, 'x.ply'), '--error', 'abc']);
+    r = runExample('reconstruct.mjs', [samplePly, '-o', path.join(dir, 'x.ply'), '--error', 'abc']);
     assert.equal(r.status, 2);
     assert.match(r.stderr, /--error needs a number/);
-    r = runExample('reconstruct.mjs', [path.join(dir, 'missing.ply'), path.join(dir, 'x.ply')]);
+    // The C CLI's flags: -o for the output, --sharp (no --no-sharp, no positional OUTPUT).
+    r = runExample('reconstruct.mjs', [samplePly, path.join(dir, 'x.ply')]);
+    assert.equal(r.status, 2);
+    r = runExample('reconstruct.mjs', [samplePly, '-o', path.join(dir, 'x.ply'), '--no-sharp']);
+    assert.equal(r.status, 2);
+    r = runExample('reconstruct.mjs', [path.join(dir, 'missing.ply'), '-o', path.join(dir, 'x.ply')]);
     assert.equal(r.status, 1);
     assert.match(r.stderr, /GMPU_ERROR_IO: .*missing\.ply/);
-    r = runExample('reconstruct.mjs', [samplePly, path.join(dir, 'x.ply'), '--max-depth', '99']);
+    r = runExample('reconstruct.mjs', [samplePly, '-o', path.join(dir, 'x.ply'), '--max-depth', '99']);
     assert.equal(r.status, 1);
     assert.match(r.stderr, /GMPU_ERROR_INVALID_ARGUMENT: GMPU_PARAM_MAX_DEPTH/);
     assert.deepEqual(fs.readdirSync(dir), [], 'no output on failure');

@@ -178,7 +178,7 @@ def test_mesh_write_reports_c_errors(tmp_path):
     assert e.value.status_name == "GMPU_ERROR_INVALID_INPUT" and e.value.function == "gmpu_mesh_create"
     ok = gmpu.Mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]])
     with pytest.raises(gmpu.UnsupportedError):
-        ok.write(tmp_path / "x.stl")
+        ok.write(tmp_path / "x.wrl")
     with pytest.raises(gmpu.IoError) as e:
         ok.write(tmp_path / "no" / "such" / "dir.ply")
     assert isinstance(e.value, OSError) and e.value.status_name == "GMPU_ERROR_IO"

@@ -30,13 +30,21 @@ def test_other_layouts_and_dtypes_are_copied():
         arr, _, _, _, stride = xyz_for_c(bad)
         assert not np.shares_memory(arr, bad) and arr.flags.c_contiguous and stride == 24
         assert np.array_equal(arr, a if bad.strides[0] > 0 else a[::-1])
-    ints = (a * 100).astype(np.int32)
-    arr, kind, _, _, _ = xyz_for_c(ints)
-    assert kind == "f64" and np.array_equal(arr, ints)
-    arr, kind, _, _, _ = xyz_for_c(a.astype(np.float16))
-    assert kind == "f64"
     arr, kind, _, _, _ = xyz_for_c(a.tolist())
     assert kind == "f64" and np.array_equal(arr, a)
+
+
+def test_arrays_of_other_dtypes_raise():
+    """The documented dtypes only: an int64 or float16 array is refused, not converted."""
+    a = np.random.default_rng(1).random((100, 3))
+    for dtype in (np.int64, np.int32, np.float16, np.longdouble, np.complex128):
+        with pytest.raises(ValueError, match="float32 or float64"):
+            xyz_for_c((a * 100).astype(dtype))
+        with pytest.raises(ValueError, match="float32 or float64"):
+            gmpu.Surface((a * 100).astype(dtype))
+    # Nested lists have no dtype: their numbers (ints too) are read as float64.
+    arr, kind, _, _, _ = xyz_for_c((a * 100).astype(int).tolist())
+    assert kind == "f64"
 
 
 def test_queries_copy_only_when_needed():

@@ -59,6 +59,24 @@ def test_exception_in_callback_cancels_fit_and_propagates(small_cloud):
         assert s.stats["cells"] > 0
 
 
+def test_returning_false_cancels_and_none_goes_on(small_cloud):
+    """The progress contract of every binding: False cancels (CancelledError), the surface
+    keeps what it had; any other return value, None included, goes on."""
+    seen = []
+
+    def progress(stage, fraction):
+        seen.append(fraction)
+        return False if len(seen) == 2 else None
+
+    with gmpu.Surface(small_cloud[0]) as s:
+        with pytest.raises(gmpu.CancelledError) as e:
+            s.fit(progress=progress)
+        assert e.value.status_name == "GMPU_ERROR_CANCELLED" and len(seen) == 2
+        assert s.stats["cells"] == 0
+        s.fit(progress=lambda st, f: 0).orient(progress=lambda st, f: True)  # only False cancels
+        assert s.stats["cells"] > 0
+
+
 def test_exception_cancels_polygonize_midway_and_keeps_the_orientation(small_cloud):
     fractions = []
 

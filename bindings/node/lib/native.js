@@ -1,6 +1,7 @@
 // Loads libgmpu with koffi and declares the C ABI of include/gmpu/gmpu.h.
 //
-// Lookup order: $GMPU_LIBRARY if set (and then only that file), else the meson build
+// Lookup order: $GMPU_LIBRARY if set (and then only that file), else the copy inside the
+// package (native/<platform>-<arch>/, put there by `npm pack`), else the meson build
 // directory of the source tree this package sits in (../../build/lib), else the system's
 // dynamic loader (libgmpu.so.1 on its search path). The library is loaded on first use, so
 // importing the package never fails; the first call does, with the list of places tried.
@@ -24,6 +25,8 @@ function sonames() {
 export function candidates(env = process.env) {
     if (env.GMPU_LIBRARY) return [{ path: env.GMPU_LIBRARY, source: 'GMPU_LIBRARY' }];
     const list = [];
+    for (const name of sonames())
+        list.push({ path: path.join(packageRoot, 'native', `${process.platform}-${process.arch}`, name), source: 'inside the package' });
     for (const name of sonames())
         list.push({ path: path.resolve(packageRoot, '..', '..', 'build', 'lib', name), source: 'meson build directory' });
     for (const name of sonames()) list.push({ path: name, source: 'system library path' });

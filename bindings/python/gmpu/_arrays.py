@@ -8,26 +8,25 @@ import numpy as np
 
 from ._library import ffi
 
-_FLOATS = (np.dtype(np.float64), np.dtype(np.float32))
-
-
 def _as_real_array(a: Any, name: str) -> np.ndarray:
-    """np.asarray(a) checked to hold real numbers: float32/float64 are kept as they are,
-    other real dtypes (ints, float16, longdouble) are converted to float64."""
+    """np.asarray(a) checked to hold float32 or float64 numbers (either byte order).
+
+    A numpy array of any other dtype (int64, float16, ...) raises ValueError rather than
+    being converted behind the caller's back; nested Python sequences of numbers, which
+    have no dtype of their own, are read as float64."""
     if hasattr(a, "positions") and not isinstance(a, np.ndarray):  # a gmpu.Points
         a = a.positions
+    given_dtype = isinstance(a, np.ndarray) or hasattr(a, "__array_interface__")
     try:
         arr = np.asarray(a)
     except Exception as e:  # ragged lists and the like
         raise ValueError(f"{name}: cannot be read as an array of numbers ({e})") from None
-    kind = arr.dtype.kind
-    if kind == "f":
-        if arr.dtype.newbyteorder("=") in _FLOATS and arr.dtype.isnative:
-            return arr
-        if arr.dtype.itemsize == 4:
-            return arr.astype(np.float32)
-        return arr.astype(np.float64)
-    if kind in "iu":
+    if arr.dtype.kind == "f" and arr.dtype.itemsize in (4, 8):
+        return arr if arr.dtype.isnative else arr.astype(arr.dtype.newbyteorder("="))
+    if given_dtype:
+        raise ValueError(f"{name}: expected float32 or float64, got dtype {arr.dtype} "
+                         "(convert it with .astype(np.float64))")
+    if arr.dtype.kind in "iu":
         return arr.astype(np.float64)
     raise ValueError(f"{name}: expected real numbers (float32 or float64), got dtype {arr.dtype}")
 

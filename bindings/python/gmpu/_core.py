@@ -10,6 +10,7 @@ from typing import Any, Dict, Optional, Union
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from . import _mesh_facts
 from ._arrays import _as_real_array, double_ptr, queries_for_c, uint32_ptr, view_of_c_memory, xyz_for_c
 from ._errors import check
 from ._library import ffi, lib
@@ -223,6 +224,49 @@ class Mesh:
     def __repr__(self) -> str:
         return f"<gmpu.Mesh {len(self._vertices)} vertices, {len(self._faces)} faces>"
 
+    def __reduce__(self):
+        # Pickled as its arrays (copies: a library mesh's are views of C memory), so a mesh
+        # can come back from multiprocessing; it unpickles as a mesh built from arrays.
+        normals = None if self._normals is None else np.array(self._normals)
+        return (Mesh, (np.array(self._vertices), np.array(self._faces), normals))
+
+    @property
+    def is_watertight(self) -> bool:
+        """Closed and consistently wound: every edge shared by two triangles, crossed once each way."""
+        return _mesh_facts.is_watertight(self._faces)
+
+    @property
+    def volume(self) -> float:
+        """Enclosed volume (divergence theorem); positive when the mesh is wound outward."""
+        return _mesh_facts.volume(self._vertices, self._faces)
+
+    @property
+    def area(self) -> float:
+        """Summed triangle area."""
+        return _mesh_facts.area(self._vertices, self._faces)
+
+    @property
+    def components(self) -> int:
+        """Number of connected pieces (triangles linked through shared vertices)."""
+        return _mesh_facts.components(len(self._vertices), self._faces)
+
+    @property
+    def genus(self) -> int:
+        """Handles of a closed mesh, summed over its pieces (0 for a sphere, 1 for a torus).
+        Raises ValueError for a mesh that is not watertight."""
+        return _mesh_facts.genus(len(self._vertices), self._faces)
+
+    def to_open3d(self):
+        """An ``open3d.geometry.TriangleMesh`` with the same vertices, triangles and vertex
+        normals (copies). Raises ImportError when Open3D is not installed."""
+        import open3d as o3d  # optional: only this method needs it
+
+        m = o3d.geometry.TriangleMesh(o3d.utility.Vector3dVector(np.array(self._vertices)),
+                                      o3d.utility.Vector3iVector(self._faces.astype(np.int32)))
+        if self._normals is not None:
+            m.vertex_normals = o3d.utility.Vector3dVector(np.array(self._normals))
+        return m
+
     def write(self, path: PathLike) -> None:
         """Writes the mesh; the format comes from the extension: .ply (binary), .obj, .off.
 
@@ -235,14 +279,14 @@ class Mesh:
         """
         p = _fspath(path)
         if self._handle is not None:
-            check(lib.gmpu_mesh_write(self._handle, p), "gmpu_mesh_write")
+            check(lib.gmpu_mesh_write(self._handle, p), "gmpu_mesh_write", os.fspath(path))
             return
         out = ffi.new("gmpu_mesh **")
         v, f = self._vertices, self._faces
         check(lib.gmpu_mesh_create(double_ptr(v), len(v), uint32_ptr(f), len(f), out), "gmpu_mesh_create")
         mesh = ffi.gc(out[0], lib.gmpu_mesh_destroy)
         try:
-            check(lib.gmpu_mesh_write(mesh, p), "gmpu_mesh_write")
+            check(lib.gmpu_mesh_write(mesh, p), "gmpu_mesh_write", os.fspath(path))
         finally:
             ffi.release(mesh)  # frees now, not at the next garbage collection
 
@@ -300,14 +344,14 @@ class Points:
         """Writes the points (and normals, if any): .ply (binary) or .xyz (ascii). Atomic."""
         p = _fspath(path)
         if self._handle is not None:
-            check(lib.gmpu_points_write(self._handle, p), "gmpu_points_write")
+            check(lib.gmpu_points_write(self._handle, p), "gmpu_points_write", os.fspath(path))
             return
         out = ffi.new("gmpu_points **")
         check(lib.gmpu_points_create(double_ptr(self._positions), double_ptr(self._normals), len(self), out),
               "gmpu_points_create")
         pts = ffi.gc(out[0], lib.gmpu_points_destroy)
         try:
-            check(lib.gmpu_points_write(pts, p), "gmpu_points_write")
+            check(lib.gmpu_points_write(pts, p), "gmpu_points_write", os.fspath(path))
         finally:
             ffi.release(pts)
 
@@ -318,7 +362,7 @@ def read_points(path: PathLike) -> Points:
     copy (no second copy). Raises gmpu.IoError, gmpu.ParseError, gmpu.UnsupportedError,
     gmpu.InvalidInputError (no points)."""
     out = ffi.new("gmpu_points **")
-    check(lib.gmpu_points_read(_fspath(path), out), "gmpu_points_read")
+    check(lib.gmpu_points_read(_fspath(path), out), "gmpu_points_read", os.fspath(path))
     return Points._from_c(out[0])
 
 

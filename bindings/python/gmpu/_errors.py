@@ -1,7 +1,9 @@
 """Exceptions: one gmpu.Error subclass per C status, each carrying the C status and message."""
 from __future__ import annotations
 
-from typing import Dict, Type
+import errno
+import os
+from typing import Dict, Optional, Type
 
 from ._library import ffi, lib
 
@@ -60,7 +62,55 @@ class CancelledError(Error):
 
 
 class IoError(Error, OSError):
-    """GMPU_ERROR_IO: a file could not be opened, read or written."""
+    """GMPU_ERROR_IO: a file could not be opened, read or written.
+
+    When the system's reason is known, the exception is also the matching builtin
+    (``FileNotFoundError``, ``PermissionError``, ``IsADirectoryError``, ``NotADirectoryError``)
+    with ``errno``, ``strerror`` and ``filename`` set; ``str()`` stays the library's message.
+    """
+
+    def __str__(self) -> str:
+        return self.message
+
+
+class IoFileNotFoundError(IoError, FileNotFoundError):
+    """GMPU_ERROR_IO for a missing file or directory (ENOENT)."""
+
+
+class IoPermissionError(IoError, PermissionError):
+    """GMPU_ERROR_IO for a file the process may not read or write (EACCES, EPERM)."""
+
+
+class IoIsADirectoryError(IoError, IsADirectoryError):
+    """GMPU_ERROR_IO for a directory where a file was expected (EISDIR)."""
+
+
+class IoNotADirectoryError(IoError, NotADirectoryError):
+    """GMPU_ERROR_IO for a path through something that is not a directory (ENOTDIR)."""
+
+
+# The library's IO messages end with the system's reason, strerror's text (the C++
+# std::generic_category() message is strerror's on glibc, as os.strerror is).
+_IO_ERRNO_CLASSES = [
+    (errno.ENOENT, IoFileNotFoundError),
+    (errno.EACCES, IoPermissionError),
+    (errno.EPERM, IoPermissionError),
+    (errno.EISDIR, IoIsADirectoryError),
+    (errno.ENOTDIR, IoNotADirectoryError),
+]
+
+
+def _io_error(message: str, status: int, name: str, function: str, filename: Optional[str]) -> IoError:
+    for code, cls in _IO_ERRNO_CLASSES:
+        reason = os.strerror(code)
+        if message.endswith(reason) or f": {reason}" in message:
+            e = cls(message, status=status, status_name=name, function=function)
+            e.errno, e.strerror = code, reason
+            e.filename = filename
+            return e
+    e = IoError(message, status=status, status_name=name, function=function)
+    e.filename = filename
+    return e
 
 
 class ParseError(Error, ValueError):
@@ -97,18 +147,21 @@ ERROR_CLASSES: Dict[str, Type[Error]] = {
 }
 
 
-def error_from_status(status: int, function: str) -> Error:
+def error_from_status(status: int, function: str, filename: Optional[str] = None) -> Error:
     """The exception for a failed call, read on the thread that made it (gmpu_last_error is
-    per thread and valid until the next gmpu call there)."""
+    per thread and valid until the next gmpu call there). filename: the file the call read
+    or wrote, given to IoError."""
     name = ffi.string(lib.gmpu_status_name(status)).decode()
     message = ffi.string(lib.gmpu_last_error()).decode("utf-8", "replace")
     if not message:
         message = f"{name}: {function} failed"
+    if name == "GMPU_ERROR_IO":
+        return _io_error(message, int(status), name, function, filename)
     cls = ERROR_CLASSES.get(name, Error)
     return cls(message, status=int(status), status_name=name, function=function)
 
 
-def check(status: int, function: str) -> None:
+def check(status: int, function: str, filename: Optional[str] = None) -> None:
     """Raises the matching Error unless status is GMPU_OK."""
     if status != 0:
-        raise error_from_status(status, function)
+        raise error_from_status(status, function, filename)

@@ -36,7 +36,9 @@ class Stage(enum.IntEnum):
 
 
 #: A progress callable: receives the stage and a fraction in [0, 1] (non-decreasing within a
-#: stage, 1.0 when it completes). Its return value is ignored; raising cancels the stage.
+#: stage, 1.0 when it completes). Returning False cancels the stage (gmpu.CancelledError; any
+#: other value, None included, goes on), as false does in Node, ControlFlow::Break in Rust and
+#: a non-zero return in C. Raising cancels it too, and the exception is re-raised.
 ProgressFn = Callable[[Stage, float], object]
 
 _tls = threading.local()
@@ -69,7 +71,8 @@ def _on_progress(user, stage, fraction):
             stage = Stage(stage)
         except ValueError:  # a stage added to the library after this binding
             stage = int(stage)
-        state.progress(stage, fraction)
+        if state.progress(stage, fraction) is False:
+            return 1
     return 0
 
 

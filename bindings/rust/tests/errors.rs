@@ -132,7 +132,7 @@ fn files_and_meshes() {
     expect_err(Mesh::new(&v, &[[0, 1, 3]]), Status::InvalidInput, "3");
     expect_err(Mesh::new(&[[0.0, f64::NAN, 0.0]], &[]), Status::InvalidInput, "");
     let mesh = Mesh::new(&v, &[[0, 1, 2]]).unwrap();
-    expect_err(mesh.write(garbage.with_extension("stl")), Status::Unsupported, "");
+    expect_err(mesh.write(garbage.with_extension("wrl")), Status::Unsupported, "");
     expect_err(mesh.write("/nonexistent/dir/mesh.ply"), Status::Io, "");
     remove_temp_dir("files_and_meshes");
 }
