@@ -61,6 +61,8 @@ fn link_gmpu(dir: &str) {
         println!("cargo:rustc-link-lib=static=gmpu");
         // The archive's C++ objects need the C++ runtime (Rust's std links libm and pthread).
         println!("cargo:rustc-link-lib=dylib=stdc++");
+        // Mesh simplification comes from the system's meshoptimizer (a shared library on Debian).
+        println!("cargo:rustc-link-lib=dylib=meshoptimizer");
         return;
     }
     link_dir(dir);

@@ -1,7 +1,8 @@
 #!/bin/bash
 # Builds consumer.c against an installed gmpu every way a user would, and runs each program:
 #   shared   cc ... $(pkg-config --cflags --libs gmpu) -Wl,-rpath,$(pkg-config --variable=libdir gmpu);
-#   static   cc -static ... $(pkg-config --static --cflags --libs gmpu): Libs.private complete;
+#   static   libgmpu.a with $(pkg-config --static --cflags --libs gmpu): Libs.private complete
+#            (the system libraries stay shared: Debian ships meshoptimizer as a .so only);
 #   cmake    find_package(gmpu) -> gmpu::gmpu and gmpu::gmpu_static;
 #   meson    gmpu as a subproject (subprojects/gmpu -> this source tree), dependency('gmpu').
 # The install is `meson install --destdir` of the given build directory into a temporary
@@ -59,9 +60,11 @@ for way in "${ways[@]}"; do
         check_run shared "$work/shared"
         ;;
     static)
-        cc -static -o "$work/static" "$here/consumer.c" $(pc --static --cflags --libs) -lm
-        if [[ $(readelf -d "$work/static") == *NEEDED* ]]; then
-            echo "consumers: the -static program still needs shared libraries" >&2
+        # -l:libgmpu.a: the archive, even where the shared library sits beside it.
+        flags=$(pc --static --cflags --libs)
+        cc -o "$work/static" "$here/consumer.c" ${flags//-lgmpu/-l:libgmpu.a} -lm
+        if [[ $(readelf -d "$work/static") == *NEEDED*libgmpu* ]]; then
+            echo "consumers: the static program still needs libgmpu.so" >&2
             exit 1
         fi
         check_run static "$work/static"
