@@ -5,6 +5,7 @@
 //! enum values and the version defines are compared with what `sys` declares. Any
 //! function, parameter (type or name), return type, field, enumerator or value that differs
 //! fails the test. The summary is `../abi.txt`, or `GMPU_ABI_SUMMARY` if set.
+mod common;
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
@@ -125,17 +126,6 @@ fn parse_summary(text: &str) -> Header {
 fn norm(rust_ty: &str) -> String {
     let s: String = rust_ty.chars().filter(|c| !c.is_whitespace()).collect();
     s.replace("std::os::raw::", "").replace("core::ffi::", "").replace("std::ffi::", "")
-}
-
-fn screaming(camel: &str) -> String {
-    let mut out = String::new();
-    for (i, c) in camel.chars().enumerate() {
-        if c.is_uppercase() && i > 0 {
-            out.push('_');
-        }
-        out.push(c.to_ascii_uppercase());
-    }
-    out
 }
 
 /// Every difference between the header and the binding, in words.
@@ -263,7 +253,7 @@ fn differences(summary: &str) -> Vec<String> {
         let mut want = header_enum(c_enum);
         want.retain(|(n, _)| n != "GMPU_OK");
         let got: Vec<(String, u32)> =
-            safe.into_iter().map(|(n, v)| (format!("{prefix}{}", screaming(&n)), v)).collect();
+            safe.into_iter().map(|(n, v)| (format!("{prefix}{}", common::screaming(&n)), v)).collect();
         if got != want {
             diffs.push(format!("safe enum for {c_enum}: header {want:?}, binding {got:?}"));
         }

@@ -1,18 +1,8 @@
 //! The binding's parameters are the library's: `Param` covers exactly the keys of
 //! `gmpu_param_info`, under the library's names, and what `ParamInfo` says (default, range,
 //! integer) is what a surface does.
+mod common;
 use gmpu::{param_count, param_table, Param, Surface};
-
-fn screaming(camel: &str) -> String {
-    let mut out = String::new();
-    for (i, c) in camel.chars().enumerate() {
-        if c.is_uppercase() && i > 0 {
-            out.push('_');
-        }
-        out.push(c.to_ascii_uppercase());
-    }
-    out
-}
 
 #[test]
 fn param_enum_is_the_librarys_table() {
@@ -22,7 +12,7 @@ fn param_enum_is_the_librarys_table() {
     assert_eq!(Param::ALL.len(), table.len(), "a library key has no Param variant (or the reverse)");
     for (p, info) in Param::ALL.iter().zip(&table) {
         assert_eq!(p.to_raw(), info.key, "{p:?}");
-        assert_eq!(screaming(&format!("{p:?}")), info.name.to_uppercase(), "{p:?}");
+        assert_eq!(common::screaming(&format!("{p:?}")), info.name.to_uppercase(), "{p:?}");
         assert_eq!(Param::from_name(info.name), Some(*p));
         assert_eq!(Param::from_name(&format!("GMPU_PARAM_{}", info.name.to_uppercase())), Some(*p));
         assert!(info.doc.len() > 10 && info.min < info.max, "{info:?}");

@@ -113,3 +113,15 @@ pub fn orientation_accuracy(normals: &[[f64; 3]], truth: &[[f64; 3]]) -> f64 {
     let good = normals.iter().zip(truth).filter(|(n, t)| dot(**n, **t) > 0.0).count();
     good as f64 / normals.len() as f64
 }
+
+/// `MaxDepth` → `MAX_DEPTH`: a Rust variant's name spelled as the C enumerator's tail.
+pub fn screaming(camel: &str) -> String {
+    let mut out = String::new();
+    for (i, c) in camel.chars().enumerate() {
+        if c.is_uppercase() && i > 0 {
+            out.push('_');
+        }
+        out.push(c.to_ascii_uppercase());
+    }
+    out
+}
