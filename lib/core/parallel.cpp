@@ -4,6 +4,9 @@
 #include <atomic>
 #include <chrono>
 
+#include <pthread.h>
+#include <signal.h>
+
 namespace gmpu {
 
 unsigned resolve_threads(unsigned requested) {
@@ -14,6 +17,12 @@ unsigned resolve_threads(unsigned requested) {
 
 Workers::Workers(unsigned threads) : requested_(resolve_threads(threads)) {
     helpers_.reserve(requested_ - 1);
+    // The pool outlives the stages, so its threads sit idle inside the host's process. They
+    // take none of its signals (a new thread inherits this mask): a SIGINT or SIGTERM goes to
+    // a host thread, whose handler can then clean up while no other thread writes on.
+    sigset_t all, host_mask;
+    sigfillset(&all);
+    pthread_sigmask(SIG_BLOCK, &all, &host_mask);
     for (unsigned t = 1; t < requested_; ++t) {
         try {
             helpers_.emplace_back([this] { helper_loop(); });
@@ -23,6 +32,7 @@ Workers::Workers(unsigned threads) : requested_(resolve_threads(threads)) {
             break;
         }
     }
+    pthread_sigmask(SIG_SETMASK, &host_mask, nullptr);
 }
 
 Workers::~Workers() {

@@ -9,6 +9,9 @@
 #include <map>
 #include <mutex>
 #include <set>
+
+#include <pthread.h>
+#include <signal.h>
 #include <thread>
 #include <random>
 #include <cstdlib>
@@ -610,6 +613,32 @@ void workers_are_reused_across_loops(void **) {
     assert_true(helper_tokens.size() <= workers.threads() - 1);
 }
 
+void workers_take_none_of_the_hosts_signals(void **) {
+    // The caller's mask is left as it was; every helper blocks SIGINT and SIGTERM, so a
+    // host's handler never runs on a pool thread while the host's own thread writes on.
+    Progress progress(nullptr, nullptr, GMPU_STAGE_FIT);
+    sigset_t before;
+    pthread_sigmask(SIG_SETMASK, nullptr, &before);
+    Workers workers(3);
+    sigset_t after;
+    pthread_sigmask(SIG_SETMASK, nullptr, &after);
+    assert_int_equal(sigismember(&after, SIGINT), sigismember(&before, SIGINT));
+    assert_int_equal(sigismember(&after, SIGTERM), sigismember(&before, SIGTERM));
+    const auto caller = std::this_thread::get_id();
+    std::atomic<int> helpers_seen{0}, helpers_open{0};
+    parallel_for(0, 64, workers, progress, [&](size_t) {
+        if (std::this_thread::get_id() != caller) {
+            sigset_t mask;
+            pthread_sigmask(SIG_SETMASK, nullptr, &mask);
+            ++helpers_seen;
+            if (!sigismember(&mask, SIGINT) || !sigismember(&mask, SIGTERM)) ++helpers_open;
+        }
+        std::this_thread::sleep_for(std::chrono::milliseconds(2));  // time for the helpers to join in
+    }, 1);
+    assert_true(helpers_seen > 0);
+    assert_int_equal(helpers_open.load(), 0);
+}
+
 void progress_slices_map_onto_the_stage(void **) {
     std::vector<double> seen;
     Progress progress([](void *user, gmpu_stage, double f) -> int {
@@ -694,6 +723,7 @@ int main(void) {
         cmocka_unit_test(parallel_for_runs_each_index_once),
         cmocka_unit_test(parallel_for_rethrows_and_cancels),
         cmocka_unit_test(workers_are_reused_across_loops),
+        cmocka_unit_test(workers_take_none_of_the_hosts_signals),
         cmocka_unit_test(progress_slices_map_onto_the_stage),
         cmocka_unit_test(cancellable_sort_sorts_and_cancels),
         cmocka_unit_test(assign_reporting_fills_and_cancels),
