@@ -68,14 +68,21 @@ void SurfaceParts::set_param(gmpu_param key, double value) {
     for (size_t k = 0; k < parts_.size(); ++k) check(gmpu_surface_set_param(parts_[k], key, value), k, size());
 }
 
+// The rows of `members` (input indices), copied packed from an array of 3 × T each, stride
+// bytes apart (0: packed).
 template <class T>
-void SurfaceParts::set_points(const T *xyz, size_t, size_t stride) {
+void gather(const T *xyz, size_t stride, const std::vector<uint32_t> &members, std::vector<T> &out) {
     if (stride == 0) stride = 3 * sizeof(T);
     const auto *bytes = reinterpret_cast<const unsigned char *>(xyz);
+    out.resize(3 * members.size());
+    for (size_t j = 0; j < members.size(); ++j) std::memcpy(&out[3 * j], bytes + members[j] * stride, 3 * sizeof(T));
+}
+
+template <class T>
+void SurfaceParts::set_points(const T *xyz, size_t, size_t stride) {
     std::vector<T> own;
     for (size_t k = 0; k < parts_.size(); ++k) {
-        own.resize(3 * members_[k].size());
-        for (size_t j = 0; j < members_[k].size(); ++j) std::memcpy(&own[3 * j], bytes + members_[k][j] * stride, 3 * sizeof(T));
+        gather(xyz, stride, members_[k], own);
         if constexpr (std::is_same_v<T, double>)
             check(gmpu_surface_set_points_f64(parts_[k], own.data(), members_[k].size(), 0), k, size());
         else
@@ -85,12 +92,9 @@ void SurfaceParts::set_points(const T *xyz, size_t, size_t stride) {
 
 template <class T>
 void SurfaceParts::set_normals(const T *nxyz, size_t, size_t stride) {
-    if (stride == 0) stride = 3 * sizeof(T);
-    const auto *bytes = reinterpret_cast<const unsigned char *>(nxyz);
     std::vector<T> own;
     for (size_t k = 0; k < parts_.size(); ++k) {
-        own.resize(3 * members_[k].size());
-        for (size_t j = 0; j < members_[k].size(); ++j) std::memcpy(&own[3 * j], bytes + members_[k][j] * stride, 3 * sizeof(T));
+        gather(nxyz, stride, members_[k], own);
         if constexpr (std::is_same_v<T, double>)
             check(gmpu_surface_set_normals_f64(parts_[k], own.data(), members_[k].size(), 0), k, size());
         else
