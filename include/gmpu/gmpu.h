@@ -160,7 +160,15 @@ typedef enum gmpu_param {
      * takes the normal of the kept point nearest to it. 0: they are fitted like the others.
      * Either way GMPU_STAT_OUTLIERS counts them. Read by set_points: set it before.
      * Default 1, range 0..1. */
-    GMPU_PARAM_REMOVE_OUTLIERS = 13
+    GMPU_PARAM_REMOVE_OUTLIERS = 13,
+    /* Which implicit evaluate and polygonize use. 0: the MPU blend of the local fits (the
+     * paper's). 1: a smooth implicit solved over the whole cloud from the oriented points
+     * (screened-Poisson-like least squares on a grid around the points), which averages the
+     * sampling noise instead of following it. 2: 1 where fit's estimated noise is at least
+     * 0.3 % of the bounding-box diagonal, else 0. Read by orient (which solves the smooth
+     * implicit) and polygonize (which solves or drops it if the value changed since).
+     * Default 2, range 0..2. */
+    GMPU_PARAM_SURFACE = 14
 } gmpu_param;
 
 /* The parameter table: what every gmpu_param key is, for bindings and tools that list,

@@ -70,7 +70,10 @@ double SurfaceField::far_value(const Eigen::Vector3d &x, Eigen::Vector3d *gradie
 }
 
 double SurfaceField::value(const Eigen::Vector3d &x, Eigen::Vector3d *gradient) const {
-    return trusted(x) ? mpu_.value(x, gradient) : far_value(x, gradient);
+    if (!trusted(x)) return far_value(x, gradient);
+    double v;
+    if (smooth_ && smooth_->value(x, v, gradient)) return v;
+    return mpu_.value(x, gradient);
 }
 
 void SurfaceField::block_values(const LatticeBlock &block, const uint32_t *near, size_t near_count,
@@ -129,7 +132,7 @@ void SurfaceField::block_values(const LatticeBlock &block, const uint32_t *near,
                 if (skip && skip[at]) continue;
                 double v;
                 if (trusted[at]) {
-                    v = mpu_.value_among(block.leaves_at(i, j, k), block.corner(i, j, k), nullptr);
+                    v = trusted_value(block.leaves_at(i, j, k), block.corner(i, j, k), nullptr);
                 } else {
                     // Trilinear in the coarse cell holding the corner.
                     const int ci = std::min(i / S, CC - 2) * S, cj = std::min(j / S, CC - 2) * S,

@@ -10,7 +10,8 @@
 // winding number is clearly 0 or 1 there (it sees every point, and the
 // nearest ones can all face away from x beyond a concave part): continuous
 // enough at the border (the blend is about a signed distance too) and never zero, so no
-// surface can appear away from the data.
+// surface can appear away from the data. With a smooth field (smooth_field.hpp), trusted
+// queries take its value instead of the blend's wherever it is defined.
 #pragma once
 
 #include <algorithm>
@@ -23,6 +24,7 @@
 #include "geometry/point_set.hpp"
 #include "implicit/mpu_function.hpp"
 #include "implicit/point_measures.hpp"
+#include "implicit/smooth_field.hpp"
 #include "implicit/winding_field.hpp"
 
 namespace gmpu {
@@ -53,9 +55,11 @@ public:
     // `winding` (built from the same measures) signs the far field where it is decisive
     // (see far_value); an empty one leaves it to the side test. All are kept by reference
     // except the blend, a small view.
+    // `smooth` (may be null or empty) replaces the blend where it is defined.
     SurfaceField(const MpuFunction &mpu, const PointSet &points, const PointMeasures &measures,
-                 const WindingField &winding)
-        : mpu_(mpu), points_(points), measures_(measures), winding_(winding) {}
+                 const WindingField &winding, const SmoothField *smooth = nullptr)
+        : mpu_(mpu), points_(points), measures_(measures), winding_(winding),
+          smooth_(smooth && !smooth->empty() ? smooth : nullptr) {}
 
     // The same field for a polygonizer's grid: `min_trust` widens every trust radius to at
     // least that (two cube sizes, so every cube the surface crosses has its corners
@@ -82,6 +86,15 @@ public:
     void block_values(const LatticeBlock &block, const uint32_t *near, size_t near_count, const uint8_t *skip,
                       double *values) const;
 
+    // The trusted value at x (the caller knows x is trusted): the smooth field's where it
+    // is defined, else the MPU blend's among `leaves`.
+    double trusted_value(const std::vector<uint32_t> &leaves, const Eigen::Vector3d &x,
+                         Eigen::Vector3d *gradient) const {
+        double v;
+        if (smooth_ && smooth_->value(x, v, gradient)) return v;
+        return mpu_.value_among(leaves, x, gradient);
+    }
+
     // Whether x lies within some point's trust radius (widened to min_trust).
     bool trusted(const Eigen::Vector3d &x) const;
     // The far field: ±(distance to the nearest point), signed by the nearby points' normals.
@@ -100,6 +113,7 @@ private:
     const PointSet &points_;
     const PointMeasures &measures_;
     const WindingField &winding_;
+    const SmoothField *smooth_ = nullptr;
     double min_trust_ = 0.0, search_bound_ = INFINITY;
 };
 

@@ -6,6 +6,7 @@
 #include "fit/noise_estimate.hpp"
 #include "implicit/mpu_function.hpp"
 #include "mesh/polygonizer.hpp"
+#include "pipeline/smooth_surface.hpp"
 
 namespace gmpu {
 
@@ -34,6 +35,7 @@ void Reconstruction::discard_fit() {
     signs.clear();
     measures = PointMeasures();
     winding = WindingField();
+    smooth.reset();
     orient_stats = {};
 }
 
@@ -54,17 +56,24 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
     Workers &pool = workers(params.threads);
     progress.report(0.0, true);
     // The steps' shares of the stage's progress.
-    Progress signs_progress = progress.slice(0.0, 0.9), measures_progress = progress.slice(0.9, 0.95),
-             winding_progress = progress.slice(0.95, 1.0);
+    const bool wants_smooth = wants_smooth_surface(params, points, noise);
+    const double signs_end = wants_smooth ? 0.8 : 0.9, winding_end = wants_smooth ? 0.85 : 1.0;
+    Progress signs_progress = progress.slice(0.0, signs_end), measures_progress = progress.slice(signs_end, signs_end + 0.05),
+             winding_progress = progress.slice(signs_end + 0.05, winding_end),
+             smooth_progress = progress.slice(winding_end, 1.0);
     // The fit is never changed, so a cancelled or failed orient leaves one the next orient
     // can use as it is.
     winding = WindingField();
+    smooth.reset();
     Orientation orientation = orient_octree(tree, points, input_normals.empty() ? nullptr : input_normals.data(),
                                             pool, signs_progress);
     const MpuFunction mpu(tree, orientation.signs, 0);
     measures = measure_points(mpu, points, pool, measures_progress);
     winding = WindingField(tree, points, measures.normals, measures.area, &winding_progress);
+    std::shared_ptr<const SmoothField> new_smooth =
+        wants_smooth ? solve_smooth_surface(params, tree, points, measures, noise, smooth_progress) : nullptr;
     finish(progress);
+    smooth = std::move(new_smooth);
     signs = std::move(orientation.signs);
     orient_stats = orientation.stats;
 }
@@ -72,8 +81,21 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
 Mesh Reconstruction::polygonize(const Params &params, int resolution, Progress &progress) {
     Workers &pool = workers(params.threads);
     progress.report(0.0, true);
+    if (wants_smooth_surface(params, points, noise) != bool(smooth)) {
+        Progress smooth_progress = progress.slice(0.0, 0.3);
+        smooth = wants_smooth_surface(params, points, noise)
+                     ? solve_smooth_surface(params, tree, points, measures, noise, smooth_progress)
+                     : nullptr;
+        Progress rest = progress.slice(0.3, 1.0);
+        return gmpu::polygonize(field(params.level), resolution, params, pool, rest);
+    }
     Mesh mesh = gmpu::polygonize(field(params.level), resolution, params, pool, progress);
     return mesh;  // the caller checks it and makes the final report
+}
+
+int Reconstruction::default_resolution(const Params &params) const {
+    return wants_smooth_surface(params, points, noise) ? smooth_resolution(tree, measures)
+                                                       : gmpu::default_resolution(tree);
 }
 
 void Reconstruction::evaluate(const Params &params, const double *xyz, size_t count, double *values,

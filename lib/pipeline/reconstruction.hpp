@@ -15,6 +15,7 @@
 #include "core/params.hpp"
 #include "core/progress.hpp"
 #include "geometry/point_set.hpp"
+#include "implicit/smooth_field.hpp"
 #include "implicit/surface_field.hpp"
 #include "implicit/winding_field.hpp"
 #include "mesh/mesh.hpp"
@@ -33,15 +34,23 @@ struct Reconstruction {
     CellSigns signs;                       // orient's result: one label per cell of the tree
     PointMeasures measures;                // orient's: oriented normals, areas, trust radii per point
     WindingField winding;                  // built from the measures; signs far regions
+    // The smooth field (pipeline/smooth_surface.hpp) when GMPU_PARAM_SURFACE asked for it
+    // at the last orient or polygonize; null: the MPU blend.
+    std::shared_ptr<const SmoothField> smooth;
     OrientStats orient_stats;
     double noise = 0.0, epsilon = 0.0;     // of the last fit, normalised units
 
     // Fit: noise estimate, ε, adaptive octree of local fits.
     void fit(const Params &params, Progress &progress);
-    // Orient: cell signs, oriented point normals and measures, winding field.
+    // Orient: cell signs, oriented point normals and measures, winding field, and the smooth
+    // field when GMPU_PARAM_SURFACE asks for it.
     void orient(const Params &params, Progress &progress);
-    // The mesh of the zero set at `resolution` (polygonizer.hpp: default_resolution).
+    // The mesh of the zero set at `resolution` (polygonizer.hpp: default_resolution). Solves
+    // or drops the smooth field first when GMPU_PARAM_SURFACE changed since orient.
     Mesh polygonize(const Params &params, int resolution, Progress &progress);
+    // Polygonize's grid when GMPU_PARAM_RESOLUTION is 0: the smooth field's when `params`
+    // asks for it, else the octree's (polygonizer.hpp: default_resolution).
+    int default_resolution(const Params &params) const;
     // f and ∇f (world frame values, unit-free gradients) at `count` world points; either
     // output may be null. Requires an oriented reconstruction.
     void evaluate(const Params &params, const double *xyz, size_t count, double *values, double *gradients) const;
@@ -50,7 +59,7 @@ struct Reconstruction {
     // leaves): the one field evaluate and polygonize both ask. A view: valid while this
     // reconstruction is not changed.
     SurfaceField field(int level) const {
-        return SurfaceField(MpuFunction(tree, signs, level), points, measures, winding);
+        return SurfaceField(MpuFunction(tree, signs, level), points, measures, winding, smooth.get());
     }
 
     // Forget fit and orient (the points stay).

@@ -299,6 +299,9 @@ key_enum! {
         MaxMemory = sys::GMPU_PARAM_MAX_MEMORY,
         /// 1 (default): set_points leaves the outliers it finds out of the fit; 0 fits them.
         RemoveOutliers = sys::GMPU_PARAM_REMOVE_OUTLIERS,
+        /// 0: the MPU blend; 1: a smooth surface solved from the oriented points; 2
+        /// (default): 1 where the estimated noise is at least 0.3 % of the diagonal.
+        Surface = sys::GMPU_PARAM_SURFACE,
     }
 }
 

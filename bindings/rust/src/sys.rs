@@ -136,6 +136,7 @@ c_enums! {
         GMPU_PARAM_NOISE_SCALE = 11,
         GMPU_PARAM_MAX_MEMORY = 12,
         GMPU_PARAM_REMOVE_OUTLIERS = 13,
+        GMPU_PARAM_SURFACE = 14,
     }
     gmpu_value_type {
         GMPU_TYPE_INT = 1,

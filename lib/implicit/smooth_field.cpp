@@ -1,0 +1,313 @@
+#include "implicit/smooth_field.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Sparse>
+
+#include "core/memory_budget.hpp"
+#include "implicit/point_measures.hpp"
+
+namespace gmpu {
+
+namespace {
+// Screening weight α = s / h, s in grid units: how hard the zero set is pulled through
+// each sample against the smoothness of the normals' integral. Strong on clean clouds (the
+// surface goes through the samples), falling with the estimated noise σ̂ (a fraction of
+// the diagonal): s = kMaxScreening · (kNoiseKnee / σ̂)^kNoisePower, bounded.
+constexpr double kNoiseKnee = 0.0035, kMinScreening = 0.5, kMaxScreening = 8.0, kNoisePower = 2.0;
+// Where the nearby normals agree this well (the length of their weighted mean), V is their
+// unit mean direction: a mean shortened by curvature would flatten f across curved parts.
+// Below it (two sheets, a thin part's two sides) V keeps its shortened length.
+constexpr double kAgreeing = 0.3;
+// Conjugate gradients stop once the residual falls below this share of the right-hand
+// side, or after kMaxIterations.
+constexpr double kTolerance = 1e-4;
+constexpr int kMaxIterations = 300;
+// Coarser levels of the cascade (each twice the previous step).
+constexpr int kCoarseLevels = 1;
+// Memory model, for GMPU_PARAM_MAX_MEMORY: per node of a touched block, the splat's sums
+// (weight, distance, normal) and its index; per unknown, the field, the edges' matrix rows
+// and the solver's vectors; per point, its 8 trilinear weights and nodes.
+constexpr double kBytesPerSlotNode = 44, kBytesPerUnknown = 200, kBytesPerPoint = 100;
+
+double weight(double d2, double r2) {
+    const double t = 1.0 - d2 / r2;
+    return t > 0.0 ? t * t : 0.0;
+}
+
+}  // namespace
+
+int32_t SmoothField::node(int64_t x, int64_t y, int64_t z) const {
+    if (x < 0 || y < 0 || z < 0 || x >= nodes_[0] || y >= nodes_[1] || z >= nodes_[2]) return -1;
+    const int32_t slot = block_slot_[size_t(x / B + blocks_[0] * (y / B + blocks_[1] * (z / B)))];
+    if (slot < 0) return -1;
+    return node_index_[size_t(slot) * B * B * B + size_t(x % B + B * (y % B + B * (z % B)))];
+}
+
+SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, double spacing, double min_trust,
+                         double noise, double max_memory, Progress &progress) {
+    if (points.size() == 0) return;
+    // The cascade: each coarser level (twice the step) solved first, its field the next
+    // level's start.
+    std::vector<double> steps{spacing};
+    for (int l = 0; l < kCoarseLevels; ++l) steps.push_back(2.0 * steps.back());
+    SmoothField coarse;
+    const double levels = double(steps.size());
+    for (size_t l = steps.size(); l-- > 1;) {
+        SmoothField level;
+        level.h_ = steps[l];
+        Progress slice = progress.slice((levels - 1 - double(l)) / levels * 0.2,
+                                        (levels - double(l)) / levels * 0.2);
+        level.solve(points, measures, min_trust, noise, max_memory, coarse.empty() ? nullptr : &coarse, slice);
+        coarse = std::move(level);
+    }
+    h_ = spacing;
+    Progress fine = progress.slice(steps.size() > 1 ? 0.2 : 0.0, 1.0);
+    solve(points, measures, min_trust, noise, max_memory, coarse.empty() ? nullptr : &coarse, fine);
+}
+
+void SmoothField::solve(const PointSet &points, const PointMeasures &measures, double min_trust, double noise,
+                        double max_memory, const SmoothField *coarse, Progress &progress) {
+    const size_t n = points.size();
+    auto radius = [&](size_t i) { return std::max(double(measures.trust_radius[i]), min_trust) + std::sqrt(3.0) * h_; };
+    double widest = 0.0;
+    for (size_t i = 0; i < n; ++i) widest = std::max(widest, radius(i));
+    origin_ = points.box_min() - Eigen::Vector3d::Constant(widest + 2.0 * h_);
+    for (int d = 0; d < 3; ++d) {
+        nodes_[d] = int64_t(std::ceil((points.box_max()[d] - origin_[d] + widest + 2.0 * h_) / h_)) + 1;
+        blocks_[d] = (nodes_[d] + B - 1) / B;
+    }
+    const char *what = "the smooth surface's solve (GMPU_PARAM_SURFACE)";
+    check_memory(double(blocks_[0]) * double(blocks_[1]) * double(blocks_[2]) * sizeof(int32_t), max_memory, what);
+    block_slot_.assign(size_t(blocks_[0] * blocks_[1] * blocks_[2]), -1);
+
+    // The nodes within each point's radius, a box of them per point.
+    auto node_box = [&](size_t i, int64_t lo[3], int64_t hi[3]) {
+        const Eigen::Vector3d p = points.point(i) - origin_;
+        const double r = radius(i);
+        for (int d = 0; d < 3; ++d) {
+            lo[d] = std::max<int64_t>(0, int64_t(std::ceil((p[d] - r) / h_)));
+            hi[d] = std::min<int64_t>(nodes_[d] - 1, int64_t(std::floor((p[d] + r) / h_)));
+        }
+    };
+    int32_t slots = 0;
+    for (size_t i = 0; i < n; ++i) {
+        if (i % 1024 == 0) progress.poll(0.05 * double(i) / double(n));
+        int64_t lo[3], hi[3];
+        node_box(i, lo, hi);
+        for (int64_t z = lo[2] / B; z <= hi[2] / B; ++z)
+            for (int64_t y = lo[1] / B; y <= hi[1] / B; ++y)
+                for (int64_t x = lo[0] / B; x <= hi[0] / B; ++x) {
+                    int32_t &s = block_slot_[size_t(x + blocks_[0] * (y + blocks_[1] * z))];
+                    if (s < 0) s = slots++;
+                }
+    }
+
+    // Every node of a touched block might be an unknown: an upper estimate, before the
+    // big allocations.
+    const double block_nodes = double(slots) * B * B * B;
+    check_memory(block_nodes * (kBytesPerSlotNode + kBytesPerUnknown) + double(n) * kBytesPerPoint, max_memory, what);
+
+    // Splat: per node the weighted sums of the normals and of the point-to-plane distances.
+    constexpr size_t BBB = size_t(B) * B * B;
+    const size_t slot_nodes = size_t(slots) * BBB;
+    std::vector<double> wsum(slot_nodes, 0.0), distance(slot_nodes, 0.0);
+    std::vector<Eigen::Vector3d> normal(slot_nodes, Eigen::Vector3d::Zero());
+    auto slot_of = [&](int64_t x, int64_t y, int64_t z) {
+        return size_t(block_slot_[size_t(x / B + blocks_[0] * (y / B + blocks_[1] * (z / B)))]) * BBB +
+               size_t(x % B + B * (y % B + B * (z % B)));
+    };
+    for (size_t i = 0; i < n; ++i) {
+        if (i % 1024 == 0) progress.poll(0.05 + 0.15 * double(i) / double(n));
+        int64_t lo[3], hi[3];
+        node_box(i, lo, hi);
+        const Eigen::Vector3d p = points.point(i);
+        const Eigen::Vector3d nrm(measures.normals[3 * i], measures.normals[3 * i + 1], measures.normals[3 * i + 2]);
+        const double r = radius(i), r2 = r * r;
+        for (int64_t z = lo[2]; z <= hi[2]; ++z)
+            for (int64_t y = lo[1]; y <= hi[1]; ++y)
+                for (int64_t x = lo[0]; x <= hi[0]; ++x) {
+                    const Eigen::Vector3d q = origin_ + h_ * Eigen::Vector3d(double(x), double(y), double(z));
+                    const double w = weight((q - p).squaredNorm(), r2);
+                    if (w <= 0.0) continue;
+                    const size_t s = slot_of(x, y, z);
+                    wsum[s] += w;
+                    normal[s] += w * nrm;
+                    distance[s] += w * (p - q).dot(nrm);  // inside (behind the normal): positive
+                }
+    }
+    node_index_.assign(slot_nodes, -1);
+    int32_t unknowns = 0;
+    for (size_t s = 0; s < slot_nodes; ++s)
+        if (wsum[s] > 0.0) node_index_[s] = unknowns++;
+
+    // Normal equations of the energy: every grid edge inside the band asks f to rise along it
+    // by h times V's component (V = −average outward normal, f grows inward), every sample
+    // asks its trilinear value to be 0. The edges make a sparse matrix; the samples' part
+    // α Sᵀ D S is applied in factored form (8 weights per sample), far fewer products than
+    // its 27-neighbour stencil assembled.
+    Eigen::VectorXd rhs = Eigen::VectorXd::Zero(unknowns), start(unknowns);
+    std::vector<Eigen::Triplet<double>> entries;
+    entries.reserve(size_t(unknowns) * 6);
+    std::vector<Eigen::Vector3d> field(static_cast<size_t>(unknowns));
+    for (int64_t z = 0; z < nodes_[2]; ++z)
+        for (int64_t y = 0; y < nodes_[1]; ++y)
+            for (int64_t x = 0; x < nodes_[0]; ++x) {
+                const int32_t u = node(x, y, z);
+                if (u < 0) continue;
+                const size_t s = slot_of(x, y, z);
+                // The start: the coarser level's field where it has one, else the smoothed
+                // point-to-plane distance.
+                double c;
+                const Eigen::Vector3d q = origin_ + h_ * Eigen::Vector3d(double(x), double(y), double(z));
+                start[u] = coarse && coarse->value(q, c, nullptr) ? c : distance[s] / wsum[s];
+                // The average normal, shortened where neighbours disagree (between two sheets,
+                // across a thin part): there f need not rise at all.
+                field[size_t(u)] = -normal[s] / wsum[s];
+                const double length = field[size_t(u)].norm();
+                if (length > kAgreeing) field[size_t(u)] /= length;
+            }
+    std::vector<double>().swap(wsum);
+    std::vector<double>().swap(distance);
+    std::vector<Eigen::Vector3d>().swap(normal);
+    const double edge_weight = h_;  // Σ over edges of h·(Δf − h·V)² approximates ∫|∇f − V|²
+    Eigen::VectorXd edge_diagonal = Eigen::VectorXd::Zero(unknowns);
+    for (int64_t z = 0; z < nodes_[2]; ++z) {
+        progress.poll(0.2 + 0.1 * double(z) / double(nodes_[2]));
+        for (int64_t y = 0; y < nodes_[1]; ++y)
+            for (int64_t x = 0; x < nodes_[0]; ++x) {
+                const int32_t a = node(x, y, z);
+                if (a < 0) continue;
+                for (int d = 0; d < 3; ++d) {
+                    const int32_t b = node(x + (d == 0), y + (d == 1), z + (d == 2));
+                    if (b < 0) continue;
+                    const double rise = h_ * 0.5 * (field[size_t(a)][d] + field[size_t(b)][d]);
+                    edge_diagonal[a] += edge_weight;
+                    edge_diagonal[b] += edge_weight;
+                    entries.emplace_back(a, b, -edge_weight);
+                    entries.emplace_back(b, a, -edge_weight);
+                    rhs[a] -= edge_weight * rise;
+                    rhs[b] += edge_weight * rise;
+                }
+            }
+    }
+    std::vector<Eigen::Vector3d>().swap(field);
+    Eigen::SparseMatrix<double, Eigen::RowMajor> edges(unknowns, unknowns);
+    edges.setFromTriplets(entries.begin(), entries.end());
+    std::vector<Eigen::Triplet<double>>().swap(entries);
+
+    const double knee = noise > 0.0 ? kNoiseKnee / noise : INFINITY;
+    const double alpha =
+        std::clamp(kMaxScreening * std::pow(knee, kNoisePower), kMinScreening, kMaxScreening) / h_;
+    Eigen::VectorXd diagonal = edge_diagonal;  // of the whole matrix: the preconditioner
+    // Every sample weighs the same (the mean area): a point's area comes from its
+    // neighbours' distances, and with noise the points pushed outward of a convex part are
+    // farther apart than those pushed inward, so area weights would pull the surface out.
+    double mean_area = 0.0;
+    for (size_t i = 0; i < n; ++i) mean_area += double(measures.area[i]) / double(n);
+    std::vector<int32_t> sample_node(8 * n, -1);
+    std::vector<double> sample_weight(8 * n, 0.0), sample_scale(n, 0.0);
+    for (size_t i = 0; i < n; ++i) {
+        if (i % 4096 == 0) progress.poll(0.3 + 0.1 * double(i) / double(n));
+        const Eigen::Vector3d t = (points.point(i) - origin_) / h_;
+        const int64_t c[3] = {int64_t(std::floor(t[0])), int64_t(std::floor(t[1])), int64_t(std::floor(t[2]))};
+        const double fx = t[0] - double(c[0]), fy = t[1] - double(c[1]), fz = t[2] - double(c[2]);
+        bool complete = true;
+        for (int k = 0; k < 8; ++k) {
+            const int dx = k & 1, dy = k >> 1 & 1, dz = k >> 2 & 1;
+            sample_node[8 * i + size_t(k)] = node(c[0] + dx, c[1] + dy, c[2] + dz);
+            complete &= sample_node[8 * i + size_t(k)] >= 0;
+            sample_weight[8 * i + size_t(k)] = (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy) * (dz ? fz : 1 - fz);
+        }
+        // Always complete (the band covers a cell diagonal around every point); a sample
+        // that were not would simply not pull.
+        sample_scale[i] = complete ? alpha * mean_area : 0.0;
+        if (!complete) continue;
+        for (int k = 0; k < 8; ++k)
+            diagonal[sample_node[8 * i + size_t(k)]] +=
+                sample_scale[i] * sample_weight[8 * i + size_t(k)] * sample_weight[8 * i + size_t(k)];
+    }
+    auto apply = [&](const Eigen::VectorXd &v, Eigen::VectorXd &out) {
+        out.noalias() = edges * v;
+        out += edge_diagonal.cwiseProduct(v);
+        for (size_t i = 0; i < n; ++i) {
+            if (sample_scale[i] == 0.0) continue;
+            const int32_t *idx = &sample_node[8 * i];
+            const double *w = &sample_weight[8 * i];
+            double at = 0.0;
+            for (int k = 0; k < 8; ++k) at += w[k] * v[idx[k]];
+            at *= sample_scale[i];
+            for (int k = 0; k < 8; ++k) out[idx[k]] += at * w[k];
+        }
+    };
+    progress.poll(0.45);
+
+    // Jacobi-preconditioned conjugate gradients, polling between iterations.
+    const Eigen::VectorXd inverse_diagonal = diagonal.cwiseInverse();
+    Eigen::VectorXd x = start, r(unknowns), Ap(unknowns);
+    apply(x, Ap);
+    r = rhs - Ap;
+    Eigen::VectorXd z = inverse_diagonal.cwiseProduct(r), p = z;
+    double rz = r.dot(z);
+    const double target = kTolerance * kTolerance * std::max(rhs.squaredNorm(), 1e-300);
+    for (int it = 0; it < kMaxIterations && r.squaredNorm() > target; ++it) {
+        progress.poll(0.45 + 0.55 * double(it) / kMaxIterations);
+        apply(p, Ap);
+        const double step = rz / p.dot(Ap);
+        x += step * p;
+        r -= step * Ap;
+        z = inverse_diagonal.cwiseProduct(r);
+        const double rz_next = r.dot(z);
+        p = z + (rz_next / rz) * p;
+        rz = rz_next;
+    }
+    // The zero set through the samples on average: with weak screening the normals' integral
+    // alone fixes f up to an offset, which would shrink or swell the whole surface.
+    double at_samples = 0.0, count = 0.0;
+    for (size_t i = 0; i < n; ++i) {
+        if (sample_scale[i] == 0.0) continue;
+        double at = 0.0;
+        for (int k = 0; k < 8; ++k) at += sample_weight[8 * i + size_t(k)] * x[sample_node[8 * i + size_t(k)]];
+        at_samples += at;
+        count += 1.0;
+    }
+    if (count > 0.0) x.array() -= at_samples / count;
+    values_.assign(x.data(), x.data() + unknowns);
+    progress.report(1.0);
+}
+
+Eigen::Vector3d SmoothField::node_gradient(int64_t x, int64_t y, int64_t z) const {
+    const int32_t c = node(x, y, z);
+    Eigen::Vector3d g;
+    for (int d = 0; d < 3; ++d) {
+        const int64_t e[3] = {d == 0, d == 1, d == 2};
+        const int32_t lo = node(x - e[0], y - e[1], z - e[2]), hi = node(x + e[0], y + e[1], z + e[2]);
+        if (lo >= 0 && hi >= 0) g[d] = (values_[size_t(hi)] - values_[size_t(lo)]) / (2 * h_);
+        else if (hi >= 0) g[d] = (values_[size_t(hi)] - values_[size_t(c)]) / h_;
+        else if (lo >= 0) g[d] = (values_[size_t(c)] - values_[size_t(lo)]) / h_;
+        else g[d] = 0.0;
+    }
+    return g;
+}
+
+bool SmoothField::value(const Eigen::Vector3d &x, double &f, Eigen::Vector3d *gradient) const {
+    if (values_.empty()) return false;
+    const Eigen::Vector3d t = (x - origin_) / h_;
+    if (!(t.array() >= 0.0).all() || !(t.array() < 1e9).all()) return false;
+    const int64_t c[3] = {int64_t(std::floor(t[0])), int64_t(std::floor(t[1])), int64_t(std::floor(t[2]))};
+    const double fx = t[0] - double(c[0]), fy = t[1] - double(c[1]), fz = t[2] - double(c[2]);
+    f = 0.0;
+    if (gradient) gradient->setZero();
+    for (int k = 0; k < 8; ++k) {
+        const int dx = k & 1, dy = k >> 1 & 1, dz = k >> 2 & 1;
+        const int32_t u = node(c[0] + dx, c[1] + dy, c[2] + dz);
+        if (u < 0) return false;
+        const double w = (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy) * (dz ? fz : 1 - fz);
+        f += w * values_[size_t(u)];
+        if (gradient) *gradient += w * node_gradient(c[0] + dx, c[1] + dy, c[2] + dz);
+    }
+    return true;
+}
+
+}  // namespace gmpu

@@ -1,0 +1,73 @@
+// A smooth global implicit solved from the oriented points (GMPU_PARAM_SURFACE = 1, and the
+// automatic choice 2 where the estimated noise says so).
+//
+// The MPU blend fits each leaf's points on their own, so at noise of a fraction of a
+// percent of the diagonal its zero set follows the noise (bumps, handles, small closed
+// pieces), and on sparse clouds the local fits have too few points to agree. Here one
+// least-squares problem spans the whole cloud, in the spirit of screened Poisson (Kazhdan &
+// Hoppe 2013): on a regular grid restricted to a band around the points, f minimises
+//     ∫ |∇f − V|²  +  α Σᵢ Aᵢ f(pᵢ)²
+// where V is the splatted field of the inward normals (unit where they agree) and the
+// screening term pulls the zero set through the points, all weighted alike (Aᵢ: their mean
+// area), with α falling as the estimated noise grows; f is then shifted so that its mean
+// over the samples is 0. The gradient term couples every sample to its neighbours, so a point's noise
+// is averaged over its neighbourhood instead of bending the surface; the normals, which
+// belief propagation made consistent, set the shape. f is about a signed distance,
+// positive inside like the MPU blend. Values between grid nodes are trilinear; gradients
+// are central differences at the nodes, interpolated the same way.
+//
+// The band reaches every point's trust radius (widened to `min_trust`) plus a cell
+// diagonal, so wherever the surface field trusts the data a smooth value exists; outside
+// it the surface field's far sign still decides (each connected part of the band holds
+// points, so the problem is well posed). The solve is cascadic: the same problem on a grid
+// twice as coarse gives the fine solve its start, so conjugate gradients only have the
+// fine detail left to converge (they converge slowly on the smooth, long-range part).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "core/progress.hpp"
+#include "geometry/point_set.hpp"
+
+namespace gmpu {
+
+struct PointMeasures;
+
+class SmoothField {
+public:
+    SmoothField() = default;
+    // `spacing`: the grid step (normalised frame); `min_trust` widens every point's trust
+    // radius for the band; `noise`: the fit's estimated noise deviation as a fraction of the
+    // bounding-box diagonal (0 if none), which sets how hard the surface is pulled through
+    // each sample. Checks its memory estimate against `max_memory` (LIMIT_EXCEEDED) and
+    // polls `progress`, which it reports to 1.
+    SmoothField(const PointSet &points, const PointMeasures &measures, double spacing, double min_trust, double noise,
+                double max_memory, Progress &progress);
+
+    // f and optionally ∇f at x; false when x lies outside the band (f is then undefined).
+    bool value(const Eigen::Vector3d &x, double &f, Eigen::Vector3d *gradient) const;
+
+    bool empty() const { return values_.empty(); }
+    size_t unknowns() const { return values_.size(); }
+    double spacing() const { return h_; }
+
+private:
+    static constexpr int B = 8;  // nodes per block side of the sparse storage
+    void solve(const PointSet &points, const PointMeasures &measures, double min_trust, double noise,
+               double max_memory, const SmoothField *coarse, Progress &progress);
+    int32_t node(int64_t x, int64_t y, int64_t z) const;  // unknown index, -1 outside the band
+    Eigen::Vector3d node_gradient(int64_t x, int64_t y, int64_t z) const;
+
+    Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();
+    double h_ = 0.0;
+    int64_t nodes_[3] = {0, 0, 0};     // per axis
+    int64_t blocks_[3] = {0, 0, 0};    // per axis
+    std::vector<int32_t> block_slot_;  // per block: its slot in node_index_ (÷ B³), or -1
+    std::vector<int32_t> node_index_;  // per slot node: unknown index or -1
+    std::vector<double> values_;       // per unknown
+};
+
+}  // namespace gmpu

@@ -1,0 +1,52 @@
+#include "pipeline/smooth_surface.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "mesh/polygonizer.hpp"
+
+namespace gmpu {
+
+namespace {
+// GMPU_PARAM_SURFACE = 2 solves the smooth field from this estimated noise on, as a fraction
+// of the bounding-box diagonal. Noise-free clouds estimate (near) 0 and keep the blend.
+constexpr double kSmoothFromNoise = 0.003;
+// The smooth grid is never finer than this many cubes along the longest side (the default
+// polygonize grid's own cap).
+constexpr int kMaxResolution = 1024;
+
+double noise_fraction(const PointSet &points, double noise) {
+    const double diagonal = points.world_diagonal() * points.normalisation().scale;  // normalised
+    return diagonal > 0.0 ? noise / diagonal : 0.0;
+}
+}  // namespace
+
+int smooth_resolution(const Octree &tree, const PointMeasures &measures) {
+    // The octree's detail sets the blend's grid, but at high noise ε is inflated and the
+    // octree stops early: its cube can be several point spacings, coarser than the detail the
+    // noise-averaged surface still has. The smooth grid is at least as fine as the points'
+    // typical spacing (the square root of the median area a point stands for).
+    std::vector<float> area(measures.area);
+    if (area.empty()) return default_resolution(tree);
+    std::nth_element(area.begin(), area.begin() + long(area.size() / 2), area.end());
+    const double spacing = std::sqrt(double(area[area.size() / 2]));
+    const int from_spacing = spacing > 0.0 ? int(std::ceil(1.0 / spacing)) : 0;
+    return std::clamp(std::max(default_resolution(tree), from_spacing), 8, kMaxResolution);
+}
+
+bool wants_smooth_surface(const Params &params, const PointSet &points, double noise) {
+    if (params.surface == 0) return false;
+    if (params.surface == 1) return true;
+    return noise_fraction(points, noise) >= kSmoothFromNoise;
+}
+
+std::shared_ptr<const SmoothField> solve_smooth_surface(const Params &params, const Octree &tree,
+                                                        const PointSet &points, const PointMeasures &measures,
+                                                        double noise, Progress &progress) {
+    const double h = 1.0 / smooth_resolution(tree, measures);
+    return std::make_shared<const SmoothField>(points, measures, h, 2.0 * h, noise_fraction(points, noise),
+                                               params.max_memory, progress);
+}
+
+}  // namespace gmpu
