@@ -248,26 +248,33 @@ double noise_of(const Scales &s) {
 
 }  // namespace
 
-double estimate_noise(const PointSet &points, Progress &progress) {
+NoiseEstimate estimate_noise_model(const PointSet &points, Progress &progress) {
+    NoiseEstimate estimate;
     size_t ball = std::min(kBall, points.size());
-    if (ball < kFar) return 0.0;
+    if (ball < kFar) return estimate;
     Scales s = measure(points, ball, kCentres, progress);
     double noise = noise_of(s);
+    bool sheets = s.flatness > kMinFlatness;
     // Heavy noise: a ball only a few σ high cuts the noise's tails; measure again in a ball
-    // tall enough (radius ∝ √points on a surface).
-    if (s.ball > 0.0 && noise * kBallPerNoise > s.ball) {
-        double want = std::pow(noise * kBallPerNoise / s.ball, 2.0) * double(ball);
+    // tall enough (radius ∝ √points on a surface). Cut tails look flat too, so the ball is
+    // sized on the uncorrected reading, and only the tall ball tells a second sheet.
+    Scales short_ball = s;
+    short_ball.flatness = 0.0;
+    const double uncorrected = noise_of(short_ball);
+    if (s.ball > 0.0 && uncorrected * kBallPerNoise > s.ball) {
+        double want = std::pow(uncorrected * kBallPerNoise / s.ball, 2.0) * double(ball);
         size_t wider = std::min({kMaxBall, points.size(), size_t(want)});
         // Fewer centres keep the cost of the taller balls bounded.
         if (wider > ball) {
             const size_t centres = std::max(kMinCentres, kCentres * ball / wider);
             const Scales tall = measure(points, wider, centres, progress);
-            // Cut tails look flat too: only the tall ball tells a second sheet.
-            s.flatness = 0.0;
-            noise = tall.flatness > kMinFlatness ? noise_of(tall) : std::max(noise_of(s), noise_of(tall));
+            sheets = tall.flatness > kMinFlatness;
+            noise = sheets ? noise_of(tall) : std::max(uncorrected, noise_of(tall));
         }
     }
-    return noise;
+    estimate.sigma = noise;
+    estimate.close_sheets = sheets && noise > 0.0;
+    return estimate;
 }
 
 }  // namespace gmpu

@@ -15,7 +15,15 @@
 
 namespace gmpu {
 
-// σ̂ in the normalised frame. Runs on the calling thread; polls progress per centre.
-double estimate_noise(const PointSet &points, Progress &progress);
+struct NoiseEstimate {
+    double sigma = 0.0;          // σ̂ in the normalised frame
+    bool close_sheets = false;   // residuals flatter than noise: sheets a few σ apart
+};
+
+// Runs on the calling thread; polls progress per centre.
+NoiseEstimate estimate_noise_model(const PointSet &points, Progress &progress);
+inline double estimate_noise(const PointSet &points, Progress &progress) {
+    return estimate_noise_model(points, progress).sigma;
+}
 
 }  // namespace gmpu

@@ -142,7 +142,7 @@ bool fit_sheets(const PointList &pts, std::vector<int> &label, double radius, Qu
 }  // namespace
 
 SheetSplit fit_two_sheets(const PointList &support, const LocalShape &single, double single_error, double radius,
-                          CellFit &out) {
+                          bool close, CellFit &out) {
     SheetSplit split;
     static const std::vector<PiecewiseShape> no_pieces;
     PointList pts;
@@ -163,7 +163,7 @@ SheetSplit fit_two_sheets(const PointList &support, const LocalShape &single, do
     std::vector<int> label(pts.size());
     for (size_t i = 0; i < pts.size(); ++i) label[i] = r[i] > groups.threshold;
     const bool separated = groups.gap >= kSeparation * groups.spread;
-    const bool flat = !separated && pts.size() >= kFlatMinSamples && kurtosis(r) < kFlatKurtosis &&
+    const bool flat = close && !separated && pts.size() >= kFlatMinSamples && kurtosis(r) < kFlatKurtosis &&
                       overlap(pts, label) > kFlatOverlap;
     if (!separated && !flat) return split;
     split.found = separated;

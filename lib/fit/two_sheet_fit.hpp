@@ -17,8 +17,10 @@ struct SheetSplit {
 
 // Looks for two sheets in `support` around the fitted `single` shape. Fills `out` with the
 // two-sheet model when one fits (its error below the single fit's); the split tells
-// whether two sheets were seen at all, fitted or not.
+// whether two sheets were seen at all, fitted or not. `close`: also look for sheets only a
+// few σ of noise apart, which the noise estimate reports cloud-wide (on a cloud without
+// them, a flat support is more often a coarse cell's shape misfit).
 SheetSplit fit_two_sheets(const PointList &support, const LocalShape &single, double single_error, double radius,
-                          CellFit &out);
+                          bool close, CellFit &out);
 
 }  // namespace gmpu

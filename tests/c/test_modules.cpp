@@ -153,6 +153,13 @@ double noise_share(const PointList &pts) {
     return estimate_noise(ps, quiet) / (ps.world_diagonal() * ps.normalisation().scale);
 }
 
+bool sees_close_sheets(const PointList &pts) {
+    std::vector<double> xyz = flat(pts);
+    PointSet ps = PointSet::from_array(xyz.data(), pts.size(), 0, 15);
+    Progress quiet(nullptr, nullptr, GMPU_STAGE_FIT);
+    return estimate_noise_model(ps, quiet).close_sheets;
+}
+
 void noise_estimate_tracks_the_noise(void **) {
     // σ as a share of the diagonal (2√3 for the unit sphere's box). At 1 % the noise is
     // twice the spacing of 30,000 points: neighbours picked by 3D distance would see it cut.
@@ -162,6 +169,7 @@ void noise_estimate_tracks_the_noise(void **) {
         fprintf(stderr, "  sigma %.4f estimated %.5f\n", share, est);
         if (share == 0) assert_true(est < 0.0001);
         else assert_true(est > 0.8 * share && est < 1.25 * share);
+        if (share > 0) assert_false(sees_close_sheets(sphere_points(30000, 1.0, share * diagonal, 17)));
     }
 }
 
@@ -186,6 +194,7 @@ void noise_estimate_sees_through_a_noisy_wall(void **) {
         double est = noise_share(pts);
         fprintf(stderr, "  noisy wall: sigma %.4f estimated %.5f\n", share, est);
         assert_true(est > 0.7 * share && est < 1.3 * share);
+        if (share == 0.005) assert_true(sees_close_sheets(pts));
     }
 }
 
@@ -207,9 +216,11 @@ void two_noisy_sheets_in_one_support(void **) {
     }
     Params params;
     const double tight = 1e-4;
-    assert_true(fit_cell(wall, 1.5, tight, tight, params).shape.model == Model::two_sheets);
-    assert_true(fit_cell(single, 1.5, tight, tight, params).shape.model != Model::two_sheets);
-    assert_true(fit_cell(wave, 1.5, tight, tight, params).shape.model != Model::two_sheets);
+    assert_true(fit_cell(wall, 1.5, tight, tight, params, true).shape.model == Model::two_sheets);
+    assert_true(fit_cell(single, 1.5, tight, tight, params, true).shape.model != Model::two_sheets);
+    assert_true(fit_cell(wave, 1.5, tight, tight, params, true).shape.model != Model::two_sheets);
+    // Only where the noise estimate saw such sheets.
+    assert_true(fit_cell(wall, 1.5, tight, tight, params, false).shape.model != Model::two_sheets);
 }
 
 void noise_estimate_ignores_sparse_detail(void **) {
