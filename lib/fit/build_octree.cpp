@@ -255,7 +255,9 @@ double effective_epsilon(const PointSet &points, const Params &params, double no
 
 Octree build_octree(const PointSet &points, const Params &params, double epsilon, Workers &workers,
                     Progress &progress, bool close_sheets) {
-    Builder b{points, params, epsilon, std::min(epsilon, requested_epsilon(points, params)), close_sheets, workers,
+    // Sheets a few σ apart matter only where the noise, not the caller, sets ε.
+    const double requested = requested_epsilon(points, params);
+    Builder b{points, params, epsilon, std::min(epsilon, requested), close_sheets && epsilon > requested, workers,
               progress, {}};
     return b.run();
 }
