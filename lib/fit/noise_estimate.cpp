@@ -43,10 +43,11 @@ constexpr double kQuantileZ = -1.2816;
 // below this quantile (for Gaussian noise the kurtosis of a sample is independent of its
 // size, so the choice does not bias it; on a cloud with walls in some parts only, these are
 // the single-sheet centres and nothing is corrected) and compared with that of Gaussian
-// residuals drawn on the same neighbourhoods. A deficit smaller than kMinFlatness is the
-// sampling spread of the mean over the centres, not a second sheet.
+// residuals drawn on the same neighbourhoods. A deficit within kFlatnessSignificance
+// standard errors of zero (measured from the centres' own spread: a tall ball is measured
+// at fewer centres) is sampling, or a surface's shape, not a second sheet.
 constexpr double kFlatnessQuantile = 0.25;
-constexpr double kMinFlatness = 0.2;
+constexpr double kFlatnessSignificance = 3.0;
 
 struct Local {
     double u, v, w;  // tangential coordinates and height in the ball's PCA frame
@@ -165,17 +166,24 @@ struct Scales {
     double flatness = 0.0;         // Gaussian residuals' kurtosis less the data's (≥ 0)
 };
 
-// Mean kurtosis of the data's and of the Gaussian residuals over the centres whose RMS
-// residual is at or below kFlatnessQuantile: how much flatter the data's are.
+// Mean kurtosis of the Gaussian residuals less the data's over the centres whose RMS
+// residual is at or below kFlatnessQuantile: how much flatter the data's are (0 unless
+// significant).
 double flatness(const std::vector<double> &far, const std::vector<double> &data, const std::vector<double> &gauss) {
-    if (far.empty()) return 0.0;
+    if (far.size() < 2) return 0.0;
     std::vector<double> sorted = far;
     const double limit = quantile(sorted, kFlatnessQuantile);
-    double d = 0.0, g = 0.0;
+    double sum = 0.0, squares = 0.0;
     size_t count = 0;
     for (size_t i = 0; i < far.size(); ++i)
-        if (far[i] <= limit) d += data[i], g += gauss[i], ++count;
-    return std::max(0.0, (g - d) / double(count));
+        if (far[i] <= limit) {
+            const double deficit = gauss[i] - data[i];
+            sum += deficit, squares += deficit * deficit, ++count;
+        }
+    if (count < 2) return 0.0;
+    const double mean = sum / double(count);
+    const double error = std::sqrt(std::max(0.0, squares / double(count) - mean * mean) / double(count - 1));
+    return mean > kFlatnessSignificance * error ? mean : 0.0;
 }
 
 Scales measure(const PointSet &points, size_t ball, size_t centres, Progress &progress) {
@@ -236,7 +244,7 @@ Scales measure(const PointSet &points, size_t ball, size_t centres, Progress &pr
 // neighbourhood's residual alone is read then.
 double noise_of(const Scales &s) {
     const double both = std::max(0.0, 2.0 * s.near * s.near - s.far * s.far);
-    if (!(s.flatness > kMinFlatness)) return std::sqrt(both);
+    if (!(s.flatness > 0.0)) return std::sqrt(both);
     const double sheet = std::min(1.0, std::sqrt(0.5 * s.flatness));
     // Flatter residuals also spread less from centre to centre (the variance of a sample's
     // variance goes with kurtosis − 1, 2 for Gaussian noise), so their low quantile stands
@@ -254,7 +262,7 @@ NoiseEstimate estimate_noise_model(const PointSet &points, Progress &progress) {
     if (ball < kFar) return estimate;
     Scales s = measure(points, ball, kCentres, progress);
     double noise = noise_of(s);
-    bool sheets = s.flatness > kMinFlatness;
+    bool sheets = s.flatness > 0.0;
     // Heavy noise: a ball only a few σ high cuts the noise's tails; measure again in a ball
     // tall enough (radius ∝ √points on a surface). Cut tails look flat too, so the ball is
     // sized on the uncorrected reading, and only the tall ball tells a second sheet.
@@ -268,7 +276,7 @@ NoiseEstimate estimate_noise_model(const PointSet &points, Progress &progress) {
         if (wider > ball) {
             const size_t centres = std::max(kMinCentres, kCentres * ball / wider);
             const Scales tall = measure(points, wider, centres, progress);
-            sheets = tall.flatness > kMinFlatness;
+            sheets = tall.flatness > 0.0;
             noise = sheets ? noise_of(tall) : std::max(uncorrected, noise_of(tall));
         }
     }
