@@ -3,7 +3,9 @@
 // of such fits makes one sheet in the middle of the wall. The two sheets show as a bimodal
 // distribution of the single fit's signed distances; they are then fitted as
 // min(w − h0(u, v), h1(u, v) − w) in one frame (h0 below h1): positive between the sheets,
-// zero on each, unit gradient, stored like a piecewise edge with two parts.
+// zero on each, unit gradient, stored like a piecewise edge with two parts. Sheets only a
+// few σ of noise apart are looked for too (flat, interleaved distances) where the noise
+// estimate saw them.
 #pragma once
 
 #include "fit/cell_fit.hpp"
