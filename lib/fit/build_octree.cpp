@@ -40,6 +40,7 @@ struct Builder {
     const Params &params;
     double epsilon;  // ε in normalised units
     double requested;  // the caller's ε, before the noise floor
+    bool close_sheets;  // look for sheets a few σ apart (two_sheet_fit.hpp)
     Workers &workers;
     Progress &progress;
     Octree tree;
@@ -86,7 +87,7 @@ struct Builder {
         }
         support.resize(idx.size());
         for (size_t k = 0; k < idx.size(); ++k) support[k] = points.point(idx[k]) - c.centre;
-        CellFit f = fit_cell(support, c.radius, epsilon, requested, params);
+        CellFit f = fit_cell(support, c.radius, epsilon, requested, params, close_sheets);
         c.unresolved_sheets = f.unresolved_sheets;
         c.support_count = uint32_t(std::max(double(idx.size()), estimate));
         c.error = float(f.error);
@@ -253,8 +254,11 @@ double effective_epsilon(const PointSet &points, const Params &params, double no
 }
 
 Octree build_octree(const PointSet &points, const Params &params, double epsilon, Workers &workers,
-                    Progress &progress) {
-    Builder b{points, params, epsilon, std::min(epsilon, requested_epsilon(points, params)), workers, progress, {}};
+                    Progress &progress, bool close_sheets) {
+    // Sheets a few σ apart matter only where the noise, not the caller, sets ε.
+    const double requested = requested_epsilon(points, params);
+    Builder b{points, params, epsilon, std::min(epsilon, requested), close_sheets && epsilon > requested, workers,
+              progress, {}};
     return b.run();
 }
 

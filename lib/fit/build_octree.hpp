@@ -20,7 +20,8 @@ namespace gmpu {
 double effective_epsilon(const PointSet &points, const Params &params, double noise);
 
 // Throws CANCELLED or LIMIT_EXCEEDED (GMPU_PARAM_MAX_CELLS). epsilon in normalised units.
+// `close_sheets`: the noise estimate saw sheets only a few σ apart (two_sheet_fit.hpp).
 Octree build_octree(const PointSet &points, const Params &params, double epsilon, Workers &workers,
-                    Progress &progress);
+                    Progress &progress, bool close_sheets = false);
 
 }  // namespace gmpu

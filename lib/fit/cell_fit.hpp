@@ -24,6 +24,8 @@ struct CellFit {
 // `epsilon` is ε in the same (normalised) units, `requested` the caller's ε before the noise
 // floor raised it: a fit worse than that is checked for two sheets (two_sheet_fit.hpp),
 // whose clean separation shows that the floor, not the data, let the fit pass.
-CellFit fit_cell(const PointList &support, double radius, double epsilon, double requested, const Params &params);
+// `close_sheets`: also look for sheets only a few σ of noise apart.
+CellFit fit_cell(const PointList &support, double radius, double epsilon, double requested, const Params &params,
+                 bool close_sheets = false);
 
 }  // namespace gmpu

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Cholesky>
@@ -36,6 +37,17 @@ constexpr size_t kSheetMinSide = 4;
 // (gear teeth, creases) is where that detail is, so a low quantile reads the noise alone.
 constexpr double kQuantile = 0.1;
 constexpr double kQuantileZ = -1.2816;
+// Two sheets closer than a few σ do not split into two groups, but their residuals are a
+// two-peaked mixture, flatter than Gaussian noise: its excess kurtosis is −2a⁴/(σ² + a²)²
+// for sheets ±a off the fit. The kurtosis is read on the centres whose residual is at or
+// below this quantile (for Gaussian noise the kurtosis of a sample is independent of its
+// size, so the choice does not bias it; on a cloud with walls in some parts only, these are
+// the single-sheet centres and nothing is corrected) and compared with that of Gaussian
+// residuals drawn on the same neighbourhoods. A deficit within kFlatnessSignificance
+// standard errors of zero (measured from the centres' own spread: a tall ball is measured
+// at fewer centres) is sampling, or a surface's shape, not a second sheet.
+constexpr double kFlatnessQuantile = 0.25;
+constexpr double kFlatnessSignificance = 3.0;
 
 struct Local {
     double u, v, w;  // tangential coordinates and height in the ball's PCA frame
@@ -84,6 +96,27 @@ void fit_height(const std::vector<Local> &fit, int terms, double scale, const st
     for (size_t i = 0; i < pts.size(); ++i) residuals[i] = pts[i].w - row(pts[i]).dot(k);
 }
 
+// Sample kurtosis m4 / m2² of residuals[0, count).
+double kurtosis(const std::vector<double> &residuals, size_t count) {
+    double m2 = 0.0, m4 = 0.0;
+    for (size_t i = 0; i < count; ++i) {
+        const double r2 = residuals[i] * residuals[i];
+        m2 += r2, m4 += r2 * r2;
+    }
+    return m2 > 0.0 ? double(count) * m4 / (m2 * m2) : 0.0;
+}
+
+// Standard normal draws from a small deterministic generator (the estimate is reproducible
+// everywhere), by Box–Muller.
+struct Gaussian {
+    uint64_t state;
+    double uniform() {
+        state = state * 6364136223846793005ull + 1442695040888963407ull;
+        return (double(state >> 11) + 0.5) * (1.0 / 9007199254740992.0);
+    }
+    double operator()() { return std::sqrt(-2.0 * std::log(uniform())) * std::cos(6.283185307179586 * uniform()); }
+};
+
 double unbiased_rms(const std::vector<double> &residuals, size_t count) {
     double sum = 0.0;
     for (size_t i = 0; i < count; ++i) sum += residuals[i] * residuals[i];
@@ -130,12 +163,35 @@ void keep_centre_sheet(std::vector<Local> &pts, double scale) {
 struct Scales {
     double near = 0.0, far = 0.0;  // median unbiased RMS residual at kNear and kFar
     double ball = 0.0;             // median ball radius
+    double flatness = 0.0;         // Gaussian residuals' kurtosis less the data's (≥ 0)
 };
+
+// Mean kurtosis of the Gaussian residuals less the data's over the centres whose RMS
+// residual is at or below kFlatnessQuantile: how much flatter the data's are (0 unless
+// significant).
+double flatness(const std::vector<double> &far, const std::vector<double> &data, const std::vector<double> &gauss) {
+    if (far.size() < 2) return 0.0;
+    std::vector<double> sorted = far;
+    const double limit = quantile(sorted, kFlatnessQuantile);
+    double sum = 0.0, squares = 0.0;
+    size_t count = 0;
+    for (size_t i = 0; i < far.size(); ++i)
+        if (far[i] <= limit) {
+            const double deficit = gauss[i] - data[i];
+            sum += deficit, squares += deficit * deficit, ++count;
+        }
+    if (count < 2) return 0.0;
+    const double mean = sum / double(count);
+    const double error = std::sqrt(std::max(0.0, squares / double(count) - mean * mean) / double(count - 1));
+    return mean > kFlatnessSignificance * error ? mean : 0.0;
+}
 
 Scales measure(const PointSet &points, size_t ball, size_t centres, Progress &progress) {
     const size_t n = points.size();
     const size_t step = std::max<size_t>(1, n / centres);
-    std::vector<double> near, far, radii, residuals;
+    std::vector<double> near, far, radii, residuals, data_kurtosis, gauss_kurtosis;
+    Gaussian draw{0x9e3779b97f4a7c15ull};
+    std::vector<Local> gauss(kFar);
     std::vector<uint32_t> idx;
     std::vector<float> d2;
     PointList local;
@@ -164,11 +220,16 @@ Scales measure(const PointSet &points, size_t ball, size_t centres, Progress &pr
         near.push_back(unbiased_rms(residuals, kNear));
         fit_height(std::vector<Local>(pts.begin(), pts.begin() + long(kFar)), 6, r, pts, residuals);
         far.push_back(unbiased_rms(residuals, kFar));
+        data_kurtosis.push_back(kurtosis(residuals, kFar));
+        for (size_t k = 0; k < kFar; ++k) gauss[k] = {pts[k].u, pts[k].v, draw(), pts[k].t2};
+        fit_height(gauss, 6, r, gauss, residuals);
+        gauss_kurtosis.push_back(kurtosis(residuals, kFar));
         radii.push_back(r);
     }
     Scales s;
     s.near = quantile(near, kQuantile) / chi_quantile(double(kNear - 6));
     s.far = quantile(far, kQuantile) / chi_quantile(double(kFar - 6));
+    s.flatness = flatness(far, data_kurtosis, gauss_kurtosis);
     s.ball = quantile(radii, 0.5);
     return s;
 }
@@ -176,27 +237,52 @@ Scales measure(const PointSet &points, size_t ball, size_t centres, Progress &pr
 // Noise is what the two scales share: σ² = 2 near² − far² cancels a residual that grows
 // at least in proportion to the neighbourhood's area (shape, sampling), and leaves noise,
 // which is the same at both.
-double noise_of(const Scales &s) { return std::sqrt(std::max(0.0, 2.0 * s.near * s.near - s.far * s.far)); }
+// When the residuals are flatter than Gaussian, a share a²/(σ² + a²) = √(deficit / 2) of
+// their variance is a second sheet's offset, and it is taken out. That offset does not grow
+// with the neighbourhood (the difference above keeps it), but its share of the points does
+// vary between the two neighbourhoods, which the difference would amplify: the larger
+// neighbourhood's residual alone is read then.
+double noise_of(const Scales &s) {
+    const double both = std::max(0.0, 2.0 * s.near * s.near - s.far * s.far);
+    if (!(s.flatness > 0.0)) return std::sqrt(both);
+    const double sheet = std::min(1.0, std::sqrt(0.5 * s.flatness));
+    // Flatter residuals also spread less from centre to centre (the variance of a sample's
+    // variance goes with kurtosis − 1, 2 for Gaussian noise), so their low quantile stands
+    // closer to the typical value than the χ correction assumed.
+    const double dof = double(kFar - 6);
+    const double far = s.far * chi_quantile(dof) / chi_quantile(dof * 2.0 / (2.0 - std::min(1.0, s.flatness)));
+    return std::sqrt(std::min(both, far * far) * (1.0 - sheet));
+}
 
 }  // namespace
 
-double estimate_noise(const PointSet &points, Progress &progress) {
+NoiseEstimate estimate_noise_model(const PointSet &points, Progress &progress) {
+    NoiseEstimate estimate;
     size_t ball = std::min(kBall, points.size());
-    if (ball < kFar) return 0.0;
+    if (ball < kFar) return estimate;
     Scales s = measure(points, ball, kCentres, progress);
     double noise = noise_of(s);
+    bool sheets = s.flatness > 0.0;
     // Heavy noise: a ball only a few σ high cuts the noise's tails; measure again in a ball
-    // tall enough (radius ∝ √points on a surface).
-    if (s.ball > 0.0 && noise * kBallPerNoise > s.ball) {
-        double want = std::pow(noise * kBallPerNoise / s.ball, 2.0) * double(ball);
+    // tall enough (radius ∝ √points on a surface). Cut tails look flat too, so the ball is
+    // sized on the uncorrected reading, and only the tall ball tells a second sheet.
+    Scales short_ball = s;
+    short_ball.flatness = 0.0;
+    const double uncorrected = noise_of(short_ball);
+    if (s.ball > 0.0 && uncorrected * kBallPerNoise > s.ball) {
+        double want = std::pow(uncorrected * kBallPerNoise / s.ball, 2.0) * double(ball);
         size_t wider = std::min({kMaxBall, points.size(), size_t(want)});
         // Fewer centres keep the cost of the taller balls bounded.
         if (wider > ball) {
             const size_t centres = std::max(kMinCentres, kCentres * ball / wider);
-            noise = std::max(noise, noise_of(measure(points, wider, centres, progress)));
+            const Scales tall = measure(points, wider, centres, progress);
+            sheets = tall.flatness > 0.0;
+            noise = sheets ? noise_of(tall) : std::max(uncorrected, noise_of(tall));
         }
     }
-    return noise;
+    estimate.sigma = noise;
+    estimate.close_sheets = sheets && noise > 0.0;
+    return estimate;
 }
 
 }  // namespace gmpu

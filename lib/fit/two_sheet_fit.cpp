@@ -19,6 +19,18 @@ constexpr size_t kMaxSamples = 512;
 constexpr size_t kOwnFitPoints = 12;
 // The two-sheet model must beat the single fit by this factor to replace it.
 constexpr double kImprovement = 0.5;
+// Sheets only a few σ of noise apart do not split into well-separated groups, but the
+// single fit's distances are then a two-peaked mixture, flatter than the Gaussian noise of
+// one sheet (kurtosis about 2.3 for sheets 2.4 σ apart, 3 for one noisy sheet), and the two
+// groups lie over one another along the surface. A wave that one model fits badly is flat
+// too, but its groups lie side by side. Read on large supports only: the sampling spread of
+// the kurtosis is √(24 / n) for Gaussian noise, and a single noisy sheet split in two must
+// not read as a wall.
+constexpr size_t kFlatMinSamples = 384;
+constexpr double kFlatKurtosis = 2.45;
+constexpr double kFlatOverlap = 0.6;
+// Within a few σ, each sheet's noise keeps the two-sheet error near the single fit's.
+constexpr double kFlatImprovement = 0.85;
 // Points of one sheet must lie this share of the gap inside the other sheet's positive side,
 // or the sheets cross within the support.
 constexpr double kClearance = 0.25;
@@ -40,6 +52,46 @@ Groups otsu(std::vector<double> &r, size_t min_group) {
     g.spread = std::sqrt(t.squared_deviations / double(r.size()));
     g.smaller = std::min(t.low, r.size() - t.low);
     return g;
+}
+
+double kurtosis(const std::vector<double> &r) {
+    double mean = 0.0;
+    for (double x : r) mean += x;
+    mean /= double(r.size());
+    double m2 = 0.0, m4 = 0.0;
+    for (double x : r) {
+        const double d2 = (x - mean) * (x - mean);
+        m2 += d2, m4 += d2 * d2;
+    }
+    return m2 > 0.0 ? double(r.size()) * m4 / (m2 * m2) : 0.0;
+}
+
+// How much the two groups lie over one another along the surface: the points are binned on
+// a 4 × 4 grid of the support's tangent plane, and the share of the smaller group that
+// finds as many points of the other group in its bins (1: fully interleaved, 0: apart).
+double overlap(const PointList &pts, const std::vector<int> &label) {
+    const Pca frame = compute_pca(pts);
+    const Eigen::Vector3d t1 = frame.axes.col(2), t2 = frame.axes.col(1);
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    for (const auto &p : pts) {
+        const double c[2] = {p.dot(t1), p.dot(t2)};
+        for (int d = 0; d < 2; ++d) lo[d] = std::min(lo[d], c[d]), hi[d] = std::max(hi[d], c[d]);
+    }
+    constexpr int kBins = 4;
+    size_t count[kBins * kBins][2] = {};
+    size_t total[2] = {0, 0};
+    for (size_t i = 0; i < pts.size(); ++i) {
+        const double c[2] = {pts[i].dot(t1), pts[i].dot(t2)};
+        int b[2];
+        for (int d = 0; d < 2; ++d)
+            b[d] = std::min(kBins - 1, int(double(kBins) * (c[d] - lo[d]) / std::max(1e-300, hi[d] - lo[d])));
+        ++count[b[0] * kBins + b[1]][label[i]];
+        ++total[label[i]];
+    }
+    size_t shared = 0;
+    for (auto &c : count) shared += std::min(c[0], c[1]);
+    const size_t smaller = std::min(total[0], total[1]);
+    return smaller > 0 ? double(shared) / double(smaller) : 0.0;
 }
 
 double signed_distance(const Quadric &q, const Eigen::Vector3d &p) {
@@ -90,7 +142,7 @@ bool fit_sheets(const PointList &pts, std::vector<int> &label, double radius, Qu
 }  // namespace
 
 SheetSplit fit_two_sheets(const PointList &support, const LocalShape &single, double single_error, double radius,
-                          CellFit &out) {
+                          bool close, CellFit &out) {
     SheetSplit split;
     static const std::vector<PiecewiseShape> no_pieces;
     PointList pts;
@@ -107,12 +159,16 @@ SheetSplit fit_two_sheets(const PointList &support, const LocalShape &single, do
     }
     std::vector<double> sorted = r;
     const Groups groups = otsu(sorted, min_group);
-    if (!(groups.gap > 1e-9 * radius) || groups.gap < kSeparation * groups.spread) return split;
-    split.found = true;
-    split.gap = groups.gap;
-
+    if (!(groups.gap > 1e-9 * radius)) return split;
     std::vector<int> label(pts.size());
     for (size_t i = 0; i < pts.size(); ++i) label[i] = r[i] > groups.threshold;
+    const bool separated = groups.gap >= kSeparation * groups.spread;
+    const bool flat = close && !separated && pts.size() >= kFlatMinSamples && kurtosis(r) < kFlatKurtosis &&
+                      overlap(pts, label) > kFlatOverlap;
+    if (!separated && !flat) return split;
+    split.found = separated;
+    split.gap = groups.gap;
+
     PiecewiseShape shape;
     if (!fit_sheets(pts, label, radius, shape.part)) return split;
     shape.count = 2;
@@ -122,7 +178,7 @@ SheetSplit fit_two_sheets(const PointList &support, const LocalShape &single, do
     local.piece = 0;
     local.q = shape.part[0];  // a smooth stand-in, never used while piece ≥ 0
     const double error = taubin_error(local, table, support);
-    if (!(error < kImprovement * single_error)) return split;
+    if (!(error < (separated ? kImprovement : kFlatImprovement) * single_error)) return split;
     out.shape = local;
     out.piece = shape;
     out.error = error;

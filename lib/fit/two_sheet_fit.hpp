@@ -3,7 +3,9 @@
 // of such fits makes one sheet in the middle of the wall. The two sheets show as a bimodal
 // distribution of the single fit's signed distances; they are then fitted as
 // min(w − h0(u, v), h1(u, v) − w) in one frame (h0 below h1): positive between the sheets,
-// zero on each, unit gradient, stored like a piecewise edge with two parts.
+// zero on each, unit gradient, stored like a piecewise edge with two parts. Sheets only a
+// few σ of noise apart are looked for too (flat, interleaved distances) where the noise
+// estimate saw them.
 #pragma once
 
 #include "fit/cell_fit.hpp"
@@ -17,8 +19,10 @@ struct SheetSplit {
 
 // Looks for two sheets in `support` around the fitted `single` shape. Fills `out` with the
 // two-sheet model when one fits (its error below the single fit's); the split tells
-// whether two sheets were seen at all, fitted or not.
+// whether two sheets were seen at all, fitted or not. `close`: also look for sheets only a
+// few σ of noise apart, which the noise estimate reports cloud-wide (on a cloud without
+// them, a flat support is more often a coarse cell's shape misfit).
 SheetSplit fit_two_sheets(const PointList &support, const LocalShape &single, double single_error, double radius,
-                          CellFit &out);
+                          bool close, CellFit &out);
 
 }  // namespace gmpu

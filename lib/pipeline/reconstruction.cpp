@@ -42,9 +42,10 @@ void Reconstruction::discard_fit() {
 void Reconstruction::fit(const Params &params, Progress &progress) {
     Workers &pool = workers(params.threads);
     progress.report(0.0, true);
-    const double new_noise = estimate_noise(points, progress);
+    const NoiseEstimate estimate = estimate_noise_model(points, progress);
+    const double new_noise = estimate.sigma;
     const double new_epsilon = effective_epsilon(points, params, new_noise);
-    Octree new_tree = build_octree(points, params, new_epsilon, pool, progress);
+    Octree new_tree = build_octree(points, params, new_epsilon, pool, progress, estimate.close_sheets);
     finish(progress);
     discard_fit();
     tree = std::move(new_tree);

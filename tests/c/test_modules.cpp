@@ -27,6 +27,7 @@
 #include "core/parallel.hpp"
 #include "core/progress.hpp"
 #include "fit/build_octree.hpp"
+#include "fit/cell_fit.hpp"
 #include "fit/fits.hpp"
 #include "fit/noise_estimate.hpp"
 #include "geometry/clusters.hpp"
@@ -152,6 +153,13 @@ double noise_share(const PointList &pts) {
     return estimate_noise(ps, quiet) / (ps.world_diagonal() * ps.normalisation().scale);
 }
 
+bool sees_close_sheets(const PointList &pts) {
+    std::vector<double> xyz = flat(pts);
+    PointSet ps = PointSet::from_array(xyz.data(), pts.size(), 0, 15);
+    Progress quiet(nullptr, nullptr, GMPU_STAGE_FIT);
+    return estimate_noise_model(ps, quiet).close_sheets;
+}
+
 void noise_estimate_tracks_the_noise(void **) {
     // σ as a share of the diagonal (2√3 for the unit sphere's box). At 1 % the noise is
     // twice the spacing of 30,000 points: neighbours picked by 3D distance would see it cut.
@@ -161,6 +169,7 @@ void noise_estimate_tracks_the_noise(void **) {
         fprintf(stderr, "  sigma %.4f estimated %.5f\n", share, est);
         if (share == 0) assert_true(est < 0.0001);
         else assert_true(est > 0.8 * share && est < 1.25 * share);
+        if (share > 0) assert_false(sees_close_sheets(sphere_points(30000, 1.0, share * diagonal, 17)));
     }
 }
 
@@ -172,6 +181,46 @@ void noise_estimate_ignores_a_second_sheet(void **) {
     double est = noise_share(pts);
     fprintf(stderr, "  two sheets: estimated %.5f\n", est);
     assert_true(est <= 0.0005);
+}
+
+void noise_estimate_sees_through_a_noisy_wall(void **) {
+    // A hollow sphere whose wall (1.2 % of the diagonal) is only 2.4 σ thick: the sheets
+    // do not split into two groups, and their offset added to the noise would read 1.5 σ.
+    const double diagonal = 2.0 * std::sqrt(3.0);
+    for (double share : {0.005, 0.01}) {
+        PointList pts = sphere_points(18000, 1.0, share * diagonal, 31),
+                  inner = sphere_points(17000, 1.0 - 0.012 * diagonal, share * diagonal, 32);
+        pts.insert(pts.end(), inner.begin(), inner.end());
+        double est = noise_share(pts);
+        fprintf(stderr, "  noisy wall: sigma %.4f estimated %.5f\n", share, est);
+        assert_true(est > 0.7 * share && est < 1.3 * share);
+        if (share == 0.005) assert_true(sees_close_sheets(pts));
+    }
+}
+
+void two_noisy_sheets_in_one_support(void **) {
+    // Two parallel sheets only 2.4 σ apart: their residuals do not split into two groups,
+    // but form a flat two-peaked mixture spread over the whole support. A single sheet with
+    // the same spread of Gaussian noise, or a clean wave one quadric cannot follow, must
+    // not be read as two.
+    std::mt19937_64 rng(41);
+    std::normal_distribution<double> g(0, 1);
+    std::uniform_real_distribution<double> u(-1, 1);
+    const double sigma = 0.02, half_gap = 1.2 * sigma;
+    PointList wall, single, wave;
+    for (int i = 0; i < 1500; ++i) {
+        const double x = u(rng), y = u(rng);
+        wall.emplace_back(x, y, (i % 2 ? half_gap : -half_gap) + sigma * g(rng));
+        single.emplace_back(x, y, std::sqrt(sigma * sigma + half_gap * half_gap) * g(rng));
+        wave.emplace_back(x, y, 0.1 * std::sin(4.0 * x));
+    }
+    Params params;
+    const double tight = 1e-4;
+    assert_true(fit_cell(wall, 1.5, tight, tight, params, true).shape.model == Model::two_sheets);
+    assert_true(fit_cell(single, 1.5, tight, tight, params, true).shape.model != Model::two_sheets);
+    assert_true(fit_cell(wave, 1.5, tight, tight, params, true).shape.model != Model::two_sheets);
+    // Only where the noise estimate saw such sheets.
+    assert_true(fit_cell(wall, 1.5, tight, tight, params, false).shape.model != Model::two_sheets);
 }
 
 void noise_estimate_ignores_sparse_detail(void **) {
@@ -711,6 +760,8 @@ int main(void) {
         cmocka_unit_test(noise_estimate_tracks_the_noise),
         cmocka_unit_test(noise_estimate_ignores_a_second_sheet),
         cmocka_unit_test(noise_estimate_ignores_sparse_detail),
+        cmocka_unit_test(noise_estimate_sees_through_a_noisy_wall),
+        cmocka_unit_test(two_noisy_sheets_in_one_support),
         cmocka_unit_test(point_set_validation),
         cmocka_unit_test(outliers_are_far_from_everything),
         cmocka_unit_test(clusters_are_groups_far_apart),
