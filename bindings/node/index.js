@@ -109,25 +109,19 @@ function namesAtImport() {
     }
 }
 
-const STATS = Object.freeze({
-    points: 1,
-    cells: 2,
-    leaves: 3,
-    depth: 4,
-    quadricCells: 5,
-    bivariateCells: 6,
-    piecewiseCells: 7,
-    components: 8,
-    flippedCells: 9,
-    fitSeconds: 10,
-    orientSeconds: 11,
-    polygonizeSeconds: 12,
-    resolution: 13,
-    bboxDiagonal: 14,
-    noise: 15,
-    effectiveError: 16,
-    outliers: 17,
-});
+// The statistics' keys by camelCase name, from the library (gmpu_stat_count /
+// gmpu_stat_name), read at import like the parameters' names (empty when it does not load).
+function statsAtImport() {
+    try {
+        const n = lib();
+        const keys = {};
+        for (let key = 1; key <= n.stat_count(); ++key) keys[camelCase(n.stat_name(key))] = key;
+        return Object.freeze(keys);
+    } catch {
+        return Object.freeze({});
+    }
+}
+const STATS = statsAtImport();
 
 const STAGES = Object.freeze({ 1: 'fit', 2: 'orient', 3: 'polygonize', 4: 'read' });
 

@@ -53,7 +53,8 @@
  *   0.3: the parameter table (gmpu_param_count, gmpu_param_info, gmpu_param_key).
  *   0.4: meshes from arrays with normals, confidence, colours (gmpu_mesh_create_with);
  *        colours of PLY points and of meshes (gmpu_points_colors, gmpu_points_create_with,
- *        gmpu_mesh_colors, gmpu_mesh_color_from_points). */
+ *        gmpu_mesh_colors, gmpu_mesh_color_from_points); statistics' names
+ *        (gmpu_stat_count, gmpu_stat_name). */
 #define GMPU_VERSION_MAJOR 0
 #define GMPU_VERSION_MINOR 4
 #define GMPU_VERSION_PATCH 0
@@ -227,6 +228,12 @@ typedef enum gmpu_stat {
                                        * spacing; unless GMPU_PARAM_REMOVE_OUTLIERS is 0 they
                                        * set no scale and join no fit */
 } gmpu_stat;
+
+/* Number of statistic keys: they are 1..gmpu_stat_count(). */
+GMPU_API int gmpu_stat_count(void);
+/* The statistic's name ("fit_seconds": the enumerator's suffix, lower case; static storage),
+ * or NULL when key is not 1..gmpu_stat_count(). */
+GMPU_API const char *gmpu_stat_name(gmpu_stat key);
 
 /* Progress and cancellation. Called on the thread that called fit / orient / polygonize,
  * at least every 50 ms of that thread's CPU time (from the call to its return, so a machine

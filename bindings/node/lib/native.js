@@ -93,6 +93,8 @@ function declare(lib) {
         param_count: f('int', 'gmpu_param_count', []),
         param_info: f('int', 'gmpu_param_info', ['int', koffi.out(koffi.pointer(paramInfo))]),
         param_key: f('int', 'gmpu_param_key', ['const char *']),
+        stat_count: f('int', 'gmpu_stat_count', []),
+        stat_name: f('const char *', 'gmpu_stat_name', ['int']),
 
         surface_create: f('int', 'gmpu_surface_create', [outPtr]),
         surface_destroy: f('void', 'gmpu_surface_destroy', ['void *']),

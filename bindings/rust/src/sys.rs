@@ -202,6 +202,8 @@ c_functions! {
     pub fn gmpu_param_count() -> c_int;
     pub fn gmpu_param_info(key: gmpu_param, info: *mut gmpu_param_info_t) -> gmpu_status;
     pub fn gmpu_param_key(name: *const c_char) -> c_int;
+    pub fn gmpu_stat_count() -> c_int;
+    pub fn gmpu_stat_name(key: gmpu_stat) -> *const c_char;
 
     pub fn gmpu_surface_create(out: *mut *mut gmpu_surface) -> gmpu_status;
     pub fn gmpu_surface_destroy(surface: *mut gmpu_surface);
