@@ -438,7 +438,9 @@ GMPU_API gmpu_status gmpu_mesh_trim(const gmpu_mesh *mesh, double threshold, gmp
 
 /* Writes the mesh; the format comes from the extension: .ply (binary little-endian),
  * .obj, .off, .stl (binary, float32, a normal per triangle), .glb (glTF 2.0 binary,
- * float32 positions, the vertex normals when the mesh has them, uint32 indices). The file is written beside the target under a temporary name and renamed,
+ * float32 positions, the vertex normals when the mesh has them, uint32 indices); .ply and
+ * .glb also carry the confidence (.ply) and the colours the mesh has. The file is written
+ * beside the target under a temporary name and renamed,
  * so a failure never leaves a partial file. A symlink as path is written through: the file
  * it points to is replaced, the link stays. Errors: INVALID_ARGUMENT, UNSUPPORTED
  * (extension), IO (with the system's reason). */
