@@ -62,6 +62,8 @@ static const char *usage =
     "                        [--trim[=T]] [--target-triangles N] [--target-error E]\n"
     "  INPUT   .ply .xyz .txt .off .obj point cloud (normals ignored unless --use-normals)\n"
     "  OUTPUT  .ply .obj .off .stl .glb mesh (closed, outward-facing; .ply with a per-vertex confidence)\n"
+    "  A .ply INPUT with uchar red green blue gives each vertex its nearest point's colour\n"
+    "  (written to .ply and .glb).\n"
     "  --keep-outliers fits the outliers found (points far from all others) too; by default\n"
     "  they are reported and set aside.\n"
     "  --trim[=T]  remove surface farther than T sample spacings from every point (default 3):\n"
@@ -402,6 +404,17 @@ static int finish_mesh(const options *o, gmpu_mesh **mesh) {
     return 1;
 }
 
+/* Coloured input (a PLY with red green blue) gives a coloured mesh: each vertex takes its
+ * nearest input point's colour. */
+static int colour_mesh(const gmpu_points *cloud, gmpu_mesh **mesh) {
+    gmpu_mesh *next = NULL;
+    if (!gmpu_points_colors(cloud)) return 1;
+    if (gmpu_mesh_color_from_points(*mesh, cloud, &next) != GMPU_OK) return !fail("colouring the mesh failed");
+    gmpu_mesh_destroy(*mesh);
+    *mesh = next;
+    return 1;
+}
+
 int main(int argc, char **argv) {
     options o;
     if (!parse_args(argc, argv, &o)) return 2;
@@ -468,7 +481,7 @@ int main(int argc, char **argv) {
     release_free_memory();
     if (gmpu_surface_polygonize(surface, &mesh) != GMPU_OK) { rc = fail("polygonize failed"); goto done; }
     release_free_memory();
-    if (!finish_mesh(&o, &mesh)) goto done;
+    if (!finish_mesh(&o, &mesh) || !colour_mesh(cloud, &mesh)) goto done;
     double t_write = now_seconds();
     mesh_vertices = gmpu_mesh_vertex_count(mesh);
     mesh_triangles = gmpu_mesh_triangle_count(mesh);

@@ -47,7 +47,7 @@ export declare class GmpuError extends Error {
 }
 
 /** The stage a progress report is about. */
-export type Stage = 'fit' | 'orient' | 'polygonize';
+export type Stage = 'fit' | 'orient' | 'polygonize' | 'read';
 
 /**
  * Progress of fit / orient / polygonize: called on the calling thread at least every 50 ms
@@ -176,6 +176,17 @@ export interface Mesh {
     normals: Float64Array | null;
     /** Per vertex: distance to the nearest input point in sample spacings (null for meshes not made by polygonize). */
     confidence: Float64Array | null;
+    /** Red green blue per vertex (null unless colorMesh gave it colours). */
+    colors?: Uint8Array | null;
+}
+
+/** What writeMesh, simplifyMesh and colorMesh take: a Mesh, or its arrays alone. */
+export interface MeshInput {
+    vertices: Points;
+    faces: Faces;
+    normals?: Float64Array | ArrayLike<number> | null;
+    confidence?: Float64Array | ArrayLike<number> | null;
+    colors?: Uint8Array | ArrayLike<number> | null;
 }
 
 /** A point cloud read from a file. */
@@ -184,6 +195,8 @@ export interface PointCloud {
     positions: Float64Array;
     /** nx ny nz per point, or null if the file has none. */
     normals: Float64Array | null;
+    /** Red green blue per point (a .ply with uchar red green blue), or null. */
+    colors?: Uint8Array | null;
     count: number;
 }
 
@@ -266,18 +279,27 @@ export declare function reconstruct(points: PointSource, options?: ReconstructOp
  */
 export declare function reconstructAsync(points: PointSource, options?: ReconstructOptions & AsyncOptions): Promise<Mesh>;
 
-/** gmpu_points_read: .ply (ascii / binary), .xyz / .txt, .off, .obj. */
-export declare function readPoints(path: string | URL): PointCloud;
+/**
+ * gmpu_points_read_with: .ply (ascii / binary), .xyz / .txt, .off, .obj. maxMemory: budget in
+ * bytes (0: half the physical memory); onProgress('read', fraction): false or a throw cancels.
+ */
+export declare function readPoints(
+    path: string | URL,
+    options?: { maxMemory?: number; onProgress?: ProgressCallback | null },
+): PointCloud;
 
 /**
- * gmpu_mesh_create + gmpu_mesh_write: .ply (binary little-endian, double coordinates),
- * .obj or .off from the extension; atomic. Vertex normals are not written.
+ * gmpu_mesh_create_with + gmpu_mesh_write: .ply (binary little-endian, double coordinates),
+ * .obj, .off, .stl or .glb from the extension; atomic; normals, confidence and colours kept.
  */
-export declare function writeMesh(path: string | URL, mesh: { vertices: Points; faces: Faces }): void;
+export declare function writeMesh(path: string | URL, mesh: MeshInput): void;
+
+/** gmpu_mesh_color_from_points: a copy whose vertices take the colour of the nearest point of cloud. */
+export declare function colorMesh(mesh: MeshInput, cloud: { positions: Points; colors: Uint8Array | ArrayLike<number> }): Mesh;
 
 /** gmpu_mesh_simplify: a decimated copy with at most targetTriangles triangles and error at most targetError × diagonal; topology kept. */
 export declare function simplifyMesh(
-    mesh: { vertices: Points; faces: Faces },
+    mesh: MeshInput,
     options?: { targetTriangles?: number; targetError?: number },
 ): Mesh;
 

@@ -109,27 +109,21 @@ function namesAtImport() {
     }
 }
 
-const STATS = Object.freeze({
-    points: 1,
-    cells: 2,
-    leaves: 3,
-    depth: 4,
-    quadricCells: 5,
-    bivariateCells: 6,
-    piecewiseCells: 7,
-    components: 8,
-    flippedCells: 9,
-    fitSeconds: 10,
-    orientSeconds: 11,
-    polygonizeSeconds: 12,
-    resolution: 13,
-    bboxDiagonal: 14,
-    noise: 15,
-    effectiveError: 16,
-    outliers: 17,
-});
+// The statistics' keys by camelCase name, from the library (gmpu_stat_count /
+// gmpu_stat_name), read at import like the parameters' names (empty when it does not load).
+function statsAtImport() {
+    try {
+        const n = lib();
+        const keys = {};
+        for (let key = 1; key <= n.stat_count(); ++key) keys[camelCase(n.stat_name(key))] = key;
+        return Object.freeze(keys);
+    } catch {
+        return Object.freeze({});
+    }
+}
+const STATS = statsAtImport();
 
-const STAGES = Object.freeze({ 1: 'fit', 2: 'orient', 3: 'polygonize' });
+const STAGES = Object.freeze({ 1: 'fit', 2: 'orient', 3: 'polygonize', 4: 'read' });
 
 /** Names of the parameters (Surface options) and statistics. */
 export const parameterNames = Object.freeze(namesAtImport());
@@ -658,23 +652,56 @@ function takeMesh(ptr) {
             faces: copyArray(n.mesh_triangles(ptr), 'uint32_t', 3 * triangleCount),
             normals: copyArray(n.mesh_normals(ptr), 'double', 3 * vertexCount),
             confidence: copyArray(n.mesh_confidence(ptr), 'double', vertexCount),
+            colors: copyArray(n.mesh_colors(ptr), 'uint8_t', 3 * vertexCount),
         };
     } finally {
         n.mesh_destroy(ptr);
     }
 }
 
+// An optional per-vertex array of a mesh object: null when absent, else `type` of `length`.
+function vertexArray(value, what, Type, length) {
+    if (value === undefined || value === null) return null;
+    const data = value instanceof Type ? value : ArrayBuffer.isView(value) || Array.isArray(value) ? Type.from(value) : null;
+    if (data === null) throw invalidArgument(`${what} must be a ${Type.name} or an array of numbers; got ${describe(value)}`);
+    if (data.length !== length) throw jsError('GMPU_ERROR_INVALID_INPUT', `${what} has ${data.length} values, expected ${length}`);
+    return data;
+}
+
+// A native mesh from { vertices, faces, normals?, confidence?, colors? } (gmpu_mesh_create_with,
+// so what writeMesh and simplifyMesh get keeps every attribute); the caller destroys it.
+function nativeMesh(mesh) {
+    if (mesh === null || typeof mesh !== 'object') throw invalidArgument('mesh must be an object { vertices, faces }');
+    const { data: vertices, count } = toXyz(mesh.vertices, 'mesh.vertices', { allowF32: false });
+    const faces = toFaces(mesh.faces, 'mesh.faces');
+    const normals = vertexArray(mesh.normals, 'mesh.normals', Float64Array, 3 * count);
+    const confidence = vertexArray(mesh.confidence, 'mesh.confidence', Float64Array, count);
+    const colors = vertexArray(mesh.colors, 'mesh.colors', Uint8Array, 3 * count);
+    const out = [null];
+    const some = (a) => (count && a !== null ? a : null);
+    check(lib().mesh_create_with(count ? vertices : null, count, faces.length ? faces : null, faces.length / 3,
+        some(normals), some(confidence), some(colors), out));
+    return out[0];
+}
+
 // ---- one call ----------------------------------------------------------------------------
+
+// A path is read here (not by Surface) so that its colours, if any, reach the mesh.
+const cloudOf = (points) => (typeof points === 'string' || points instanceof URL ? readPoints(points) : points);
+// Coloured points give a coloured mesh (each vertex: its nearest point's colour), as the C CLI does.
+const coloured = (mesh, cloud) => (cloud?.colors instanceof Uint8Array ? colorMesh(mesh, cloud) : mesh);
 
 /**
  * Unoriented points in, closed outward-facing mesh out: set points → fit → orient →
- * polygonize with the given parameters. Returns { vertices, faces, normals }.
+ * polygonize with the given parameters. Returns { vertices, faces, normals, confidence,
+ * colors }.
  */
 export function reconstruct(points, options = {}) {
     if (!isPointSource(points)) throw invalidArgument(`points must be point coordinates, a PointCloud or a path; got ${describe(points)}`);
-    const surface = new Surface(points, options);
+    const cloud = cloudOf(points);
+    const surface = new Surface(cloud, options);
     try {
-        return surface.fit().orient().polygonize();
+        return coloured(surface.fit().orient().polygonize(), cloud);
     } finally {
         surface.close();
     }
@@ -690,11 +717,12 @@ export async function reconstructAsync(points, options = {}) {
     if (options === null || typeof options !== 'object') throw invalidArgument('options must be an object');
     const { signal, ...rest } = options;
     signalOf({ signal });
-    const surface = new Surface(points, rest);
+    const cloud = cloudOf(points);
+    const surface = new Surface(cloud, rest);
     try {
         await surface.fitAsync({ signal });
         await surface.orientAsync({ signal });
-        return await surface.polygonizeAsync({ signal });
+        return coloured(await surface.polygonizeAsync({ signal }), cloud);
     } finally {
         surface.close();
     }
@@ -702,18 +730,47 @@ export async function reconstructAsync(points, options = {}) {
 
 // ---- files -------------------------------------------------------------------------------
 
-/** Reads a point cloud (.ply, .xyz, .txt, .off, .obj): { positions, normals | null, count }. */
-export function readPoints(file) {
+/**
+ * Reads a point cloud (.ply, .xyz, .txt, .off, .obj): { positions, normals | null, colors |
+ * null, count } (gmpu_points_read_with). options.maxMemory: the budget in bytes (0 or absent:
+ * half the physical memory); options.onProgress(stage 'read', fraction): returning false or
+ * throwing cancels (GMPU_ERROR_CANCELLED; a throw is rethrown), as for the stages.
+ */
+export function readPoints(file, options = {}) {
     const p = toPath(file);
+    if (options === null || typeof options !== 'object') throw invalidArgument('options must be an object');
+    const { maxMemory = 0, onProgress = null, ...unknown } = options;
+    const extra = Object.keys(unknown);
+    if (extra.length) throw invalidArgument(`unknown option '${extra[0]}' (options: maxMemory, onProgress)`);
+    if (typeof maxMemory !== 'number') throw invalidArgument(`maxMemory must be a number, got ${describe(maxMemory)}`);
+    if (onProgress !== null && typeof onProgress !== 'function') throw invalidArgument('onProgress must be a function');
     const n = lib();
     const out = [null];
-    check(n.points_read(p, out));
+    let thrown = null;
+    const callback = onProgress === null ? null : koffi.register((_user, stage, fraction) => {
+        if (thrown !== null) return 1;
+        try {
+            return onProgress(STAGES[stage] ?? String(stage), fraction) === false ? 1 : 0;
+        } catch (err) {
+            thrown = { err };
+            return 1;
+        }
+    }, n.progressType);
+    let status;
+    try {
+        status = n.points_read_with(p, maxMemory, callback, null, out);
+    } finally {
+        if (callback !== null) koffi.unregister(callback);
+    }
+    if (thrown !== null) throw thrown.err;
+    check(status);
     const ptr = out[0];
     try {
         const count = Number(n.points_count(ptr));
         return {
             positions: copyArray(n.points_positions(ptr), 'double', 3 * count),
             normals: copyArray(n.points_normals(ptr), 'double', 3 * count),
+            colors: copyArray(n.points_colors(ptr), 'uint8_t', 3 * count),
             count,
         };
     } finally {
@@ -722,32 +779,53 @@ export function readPoints(file) {
 }
 
 /**
- * Writes a mesh { vertices, faces } (.ply binary little-endian, .obj, .off; from the
- * extension), atomically. Vertex normals are not written: the C ABI builds meshes from
- * positions and triangles only.
+ * Writes a mesh { vertices, faces, normals?, confidence?, colors? } (.ply binary
+ * little-endian, .obj, .off, .stl, .glb; from the extension), atomically, with the
+ * attributes it has, as the C CLI writes them.
  */
 export function writeMesh(file, mesh) {
     const p = toPath(file);
-    if (mesh === null || typeof mesh !== 'object') throw invalidArgument('mesh must be an object { vertices, faces }');
-    const { data: vertices, count: vertexCount } = toXyz(mesh.vertices, 'mesh.vertices', { allowF32: false });
-    const faces = toFaces(mesh.faces, 'mesh.faces');
-    const n = lib();
-    const out = [null];
-    check(n.mesh_create(vertexCount ? vertices : null, vertexCount, faces.length ? faces : null, faces.length / 3, out));
+    const made = nativeMesh(mesh);
     try {
-        check(n.mesh_write(out[0], p));
+        check(lib().mesh_write(made, p));
     } finally {
-        n.mesh_destroy(out[0]);
+        lib().mesh_destroy(made);
     }
 }
 
 /**
- * Decimates a mesh { vertices, faces } (gmpu_mesh_simplify): at most
+ * A copy of mesh whose every vertex takes the colour of the nearest point of cloud
+ * { positions, colors } (as readPoints gives a coloured .ply; gmpu_mesh_color_from_points).
+ */
+export function colorMesh(mesh, cloud) {
+    if (cloud === null || typeof cloud !== 'object') throw invalidArgument('cloud must be an object { positions, colors }');
+    const { data: positions, count } = toXyz(cloud.positions, 'cloud.positions', { allowF32: false });
+    const colors = vertexArray(cloud.colors, 'cloud.colors', Uint8Array, 3 * count);
+    if (colors === null) throw invalidArgument('cloud has no colors');
+    const n = lib();
+    const points = [null];
+    check(n.points_create_with(count ? positions : null, null, count ? colors : null, count, points));
+    try {
+        const made = nativeMesh(mesh);
+        try {
+            const out = [null];
+            check(n.mesh_color_from_points(made, points[0], out));
+            return takeMesh(out[0]);
+        } finally {
+            n.mesh_destroy(made);
+        }
+    } finally {
+        n.points_destroy(points[0]);
+    }
+}
+
+/**
+ * Decimates a mesh { vertices, faces, confidence?, colors? } (gmpu_mesh_simplify): at most
  * options.targetTriangles triangles (0 or absent: no count target), the surface moved by at
  * most options.targetError × the bounding-box diagonal (default 1: no bound). Topology is
  * kept (closed, manifold, components, genus), so it may stop above the count. Returns a new
- * { vertices, faces, normals, confidence } with recomputed normals (confidence null: meshes
- * built from arrays carry none).
+ * { vertices, faces, normals, confidence, colors } with recomputed normals (confidence and
+ * colors carried when the input has them, else null).
  */
 export function simplifyMesh(mesh, options = {}) {
     if (mesh === null || typeof mesh !== 'object') throw invalidArgument('mesh must be an object { vertices, faces }');
@@ -758,17 +836,14 @@ export function simplifyMesh(mesh, options = {}) {
     if (!Number.isSafeInteger(targetTriangles) || targetTriangles < 0)
         throw invalidArgument(`targetTriangles must be a non-negative integer, got ${describe(targetTriangles)}`);
     if (typeof targetError !== 'number') throw invalidArgument(`targetError must be a number, got ${describe(targetError)}`);
-    const { data: vertices, count: vertexCount } = toXyz(mesh.vertices, 'mesh.vertices', { allowF32: false });
-    const faces = toFaces(mesh.faces, 'mesh.faces');
     const n = lib();
-    const made = [null];
-    check(n.mesh_create(vertexCount ? vertices : null, vertexCount, faces.length ? faces : null, faces.length / 3, made));
+    const made = nativeMesh(mesh);
     try {
         const out = [null];
-        check(n.mesh_simplify(made[0], targetTriangles, targetError, out));
+        check(n.mesh_simplify(made, targetTriangles, targetError, out));
         return takeMesh(out[0]);
     } finally {
-        n.mesh_destroy(made[0]);
+        n.mesh_destroy(made);
     }
 }
 

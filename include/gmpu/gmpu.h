@@ -50,11 +50,15 @@
 /* Version of this header. Compare with gmpu_version_number() to detect a mismatched
  * library at run time. GMPU_ABI_VERSION changes only when the ABI breaks (it is the
  * SONAME's number: libgmpu.so.1). The minor version grows with every addition:
- *   0.3: the parameter table (gmpu_param_count, gmpu_param_info, gmpu_param_key). */
+ *   0.3: the parameter table (gmpu_param_count, gmpu_param_info, gmpu_param_key).
+ *   0.4: meshes from arrays with normals, confidence, colours (gmpu_mesh_create_with);
+ *        colours of PLY points and of meshes (gmpu_points_colors, gmpu_points_create_with,
+ *        gmpu_mesh_colors, gmpu_mesh_color_from_points); statistics' names
+ *        (gmpu_stat_count, gmpu_stat_name). */
 #define GMPU_VERSION_MAJOR 0
-#define GMPU_VERSION_MINOR 3
+#define GMPU_VERSION_MINOR 4
 #define GMPU_VERSION_PATCH 0
-#define GMPU_VERSION_NUMBER 300 /* MAJOR*10000 + MINOR*100 + PATCH */
+#define GMPU_VERSION_NUMBER 400 /* MAJOR*10000 + MINOR*100 + PATCH */
 #define GMPU_ABI_VERSION 1
 
 #ifdef __cplusplus
@@ -233,6 +237,12 @@ typedef enum gmpu_stat {
                                        * set no scale and join no fit */
 } gmpu_stat;
 
+/* Number of statistic keys: they are 1..gmpu_stat_count(). */
+GMPU_API int gmpu_stat_count(void);
+/* The statistic's name ("fit_seconds": the enumerator's suffix, lower case; static storage),
+ * or NULL when key is not 1..gmpu_stat_count(). */
+GMPU_API const char *gmpu_stat_name(gmpu_stat key);
+
 /* Progress and cancellation. Called on the thread that called fit / orient / polygonize,
  * at least every 50 ms of that thread's CPU time (from the call to its return, so a machine
  * busy with other work stretches the wall-clock interval) and at most every 10 ms, with
@@ -374,6 +384,16 @@ GMPU_API gmpu_status gmpu_surface_polygonize(gmpu_surface *surface, gmpu_mesh **
 GMPU_API gmpu_status gmpu_mesh_create(const double *vertices, size_t vertex_count,
                                       const uint32_t *triangles, size_t triangle_count,
                                       gmpu_mesh **out);
+/* gmpu_mesh_create with per-vertex attributes, each optional (NULL: none): normals
+ * (3 × vertex_count doubles, any finite non-zero length; kept as unit vectors), confidence
+ * (vertex_count doubles, >= 0 or +inf, as gmpu_mesh_confidence) and colors (3 × vertex_count
+ * bytes, red green blue). Lets a binding rebuild a mesh it holds as arrays without losing
+ * what gmpu_mesh_write writes. Errors: those of gmpu_mesh_create; INVALID_INPUT also for a
+ * zero or non-finite normal or a negative or NaN confidence, naming the vertex. */
+GMPU_API gmpu_status gmpu_mesh_create_with(const double *vertices, size_t vertex_count,
+                                           const uint32_t *triangles, size_t triangle_count,
+                                           const double *normals, const double *confidence,
+                                           const uint8_t *colors, gmpu_mesh **out);
 GMPU_API void gmpu_mesh_destroy(gmpu_mesh *mesh); /* NULL is a no-op */
 
 GMPU_API size_t gmpu_mesh_vertex_count(const gmpu_mesh *mesh);   /* 0 for NULL */
@@ -381,7 +401,7 @@ GMPU_API size_t gmpu_mesh_triangle_count(const gmpu_mesh *mesh); /* 0 for NULL *
 /* xyz per vertex (3 × vertex_count doubles). */
 GMPU_API const double *gmpu_mesh_vertices(const gmpu_mesh *mesh);
 /* Unit outward normal per vertex (3 × vertex_count doubles); NULL for a mesh made by
- * gmpu_mesh_create. */
+ * gmpu_mesh_create (or gmpu_mesh_create_with without normals). */
 GMPU_API const double *gmpu_mesh_normals(const gmpu_mesh *mesh);
 /* Three vertex indices per triangle (3 × triangle_count). */
 GMPU_API const uint32_t *gmpu_mesh_triangles(const gmpu_mesh *mesh);
@@ -391,6 +411,17 @@ GMPU_API const uint32_t *gmpu_mesh_triangles(const gmpu_mesh *mesh);
  * for a mesh made by gmpu_mesh_create. Simplify and trim carry it; .ply files get it as
  * a float vertex property "confidence". */
 GMPU_API const double *gmpu_mesh_confidence(const gmpu_mesh *mesh);
+/* Colour per vertex: red green blue bytes (3 × vertex_count, sRGB as PLY files hold them);
+ * NULL when the mesh has none. Simplify and trim carry them; .ply files get uchar red green
+ * blue, .glb files COLOR_0 (linear float, as glTF defines it). */
+GMPU_API const uint8_t *gmpu_mesh_colors(const gmpu_mesh *mesh);
+
+/* A copy of mesh whose every vertex takes the colour of the point of points nearest to it
+ * (give the points the surface was made from: the nearest is the sample the vertex stands
+ * for). Errors: INVALID_ARGUMENT (NULL, points without colours), OUT_OF_MEMORY.
+ * Cost: O((vertices + points) log points). */
+GMPU_API gmpu_status gmpu_mesh_color_from_points(const gmpu_mesh *mesh, const gmpu_points *points,
+                                                 gmpu_mesh **out);
 
 /* Decimation: a new mesh with fewer triangles, the input untouched. Vertices at identical
  * positions are first welded; then edges collapse (quadric error, meshoptimizer) until at
@@ -415,7 +446,9 @@ GMPU_API gmpu_status gmpu_mesh_trim(const gmpu_mesh *mesh, double threshold, gmp
 
 /* Writes the mesh; the format comes from the extension: .ply (binary little-endian),
  * .obj, .off, .stl (binary, float32, a normal per triangle), .glb (glTF 2.0 binary,
- * float32 positions, the vertex normals when the mesh has them, uint32 indices). The file is written beside the target under a temporary name and renamed,
+ * float32 positions, the vertex normals when the mesh has them, uint32 indices); .ply and
+ * .glb also carry the confidence (.ply) and the colours the mesh has. The file is written
+ * beside the target under a temporary name and renamed,
  * so a failure never leaves a partial file. A symlink as path is written through: the file
  * it points to is replaced, the link stays. Errors: INVALID_ARGUMENT, UNSUPPORTED
  * (extension), IO (with the system's reason). */
@@ -423,8 +456,8 @@ GMPU_API gmpu_status gmpu_mesh_write(const gmpu_mesh *mesh, const char *path);
 
 /* ---- point files --------------------------------------------------------------------- */
 
-/* Reads a point cloud: .ply (ascii, binary little or big endian; x y z and optional
- * nx ny nz; other properties and elements skipped), .xyz / .txt (3 or 6 columns),
+/* Reads a point cloud: .ply (ascii, binary little or big endian; x y z, optional
+ * nx ny nz, optional uchar red green blue; other properties and elements skipped), .xyz / .txt (3 or 6 columns),
  * .off and .obj (vertices only). Only regular files are read: a FIFO, a device or a
  * directory fails at once. Errors: INVALID_ARGUMENT, IO (missing, unreadable, not a regular
  * file), PARSE (malformed, truncated or lying header, not the format its extension says;
@@ -447,11 +480,18 @@ GMPU_API gmpu_status gmpu_points_read_with(const char *path, double max_memory, 
 /* Builds a point set from caller arrays (copied); normals may be NULL. */
 GMPU_API gmpu_status gmpu_points_create(const double *xyz, const double *normals,
                                         size_t count, gmpu_points **out);
+/* gmpu_points_create with colours: colors (may be NULL) holds red green blue bytes per
+ * point (3 × count), as gmpu_points_colors gives them, for gmpu_mesh_color_from_points. */
+GMPU_API gmpu_status gmpu_points_create_with(const double *xyz, const double *normals, const uint8_t *colors,
+                                             size_t count, gmpu_points **out);
 GMPU_API void gmpu_points_destroy(gmpu_points *points); /* NULL is a no-op */
 
 GMPU_API size_t gmpu_points_count(const gmpu_points *points);           /* 0 for NULL */
 GMPU_API const double *gmpu_points_positions(const gmpu_points *points); /* 3 × count */
 GMPU_API const double *gmpu_points_normals(const gmpu_points *points);   /* NULL if none */
+/* Red green blue bytes per point (3 × count), from a .ply file with uchar red green blue;
+ * NULL if none. */
+GMPU_API const uint8_t *gmpu_points_colors(const gmpu_points *points);
 
 /* Writes points (and normals, if any): .ply (binary little-endian) or .xyz (ascii).
  * Atomic like gmpu_mesh_write. Errors: INVALID_ARGUMENT, UNSUPPORTED, IO. */

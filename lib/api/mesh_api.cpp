@@ -9,14 +9,15 @@
 #include "api/handles.hpp"
 #include "gmpu/gmpu.h"
 #include "io/io.hpp"
+#include "mesh/colour_transfer.hpp"
 #include "mesh/confidence.hpp"
 #include "mesh/simplify.hpp"
 
 extern "C" {
 
-GMPU_API gmpu_status gmpu_mesh_create(const double *vertices, size_t vertex_count,
-                                      const uint32_t *triangles, size_t triangle_count,
-                                      gmpu_mesh **out) {
+GMPU_API gmpu_status gmpu_mesh_create_with(const double *vertices, size_t vertex_count, const uint32_t *triangles,
+                                           size_t triangle_count, const double *normals, const double *confidence,
+                                           const uint8_t *colors, gmpu_mesh **out) {
     using gmpu::Error;
     return gmpu::api::guarded(nullptr, [&] {
         gmpu::api::require_arg(out, "out");
@@ -40,7 +41,59 @@ GMPU_API gmpu_status gmpu_mesh_create(const double *vertices, size_t vertex_coun
                             "triangle " + std::to_string(i / 3) + " uses vertex index " +
                                 std::to_string(mesh->mesh.triangles[i]) + ", but vertex_count is " +
                                 std::to_string(vertex_count));
+        if (normals && vertex_count > 0) {
+            std::vector<double> &n = mesh->mesh.normals;
+            n.assign(normals, normals + 3 * vertex_count);
+            for (size_t v = 0; v < vertex_count; ++v) {
+                const double length = std::hypot(n[3 * v], n[3 * v + 1], n[3 * v + 2]);
+                if (!(std::isfinite(length) && length > 0))
+                    throw Error(GMPU_ERROR_INVALID_INPUT,
+                                "normal of vertex " + std::to_string(v) + " is zero or not finite");
+                // The accessor promises unit normals; unit ones are kept bit for bit, so a mesh
+                // copied through arrays writes the same file as the original.
+                if (std::fabs(length - 1.0) > 1e-12)
+                    for (size_t k = 0; k < 3; ++k) n[3 * v + k] /= length;
+            }
+        }
+        if (confidence && vertex_count > 0) {
+            mesh->mesh.confidence.assign(confidence, confidence + vertex_count);
+            for (size_t v = 0; v < vertex_count; ++v)
+                if (!(confidence[v] >= 0 && confidence[v] <= INFINITY))  // polygonize gives +inf to the unsupported
+                    throw Error(GMPU_ERROR_INVALID_INPUT,
+                                "confidence of vertex " + std::to_string(v) + " is negative or NaN");
+        }
+        if (colors && vertex_count > 0) mesh->mesh.colors.assign(colors, colors + 3 * vertex_count);
         *out = mesh.release();
+    });
+}
+
+GMPU_API gmpu_status gmpu_mesh_create(const double *vertices, size_t vertex_count, const uint32_t *triangles,
+                                      size_t triangle_count, gmpu_mesh **out) {
+    return gmpu_mesh_create_with(vertices, vertex_count, triangles, triangle_count, nullptr, nullptr, nullptr, out);
+}
+
+GMPU_API const uint8_t *gmpu_mesh_colors(const gmpu_mesh *mesh) {
+    const uint8_t *p = nullptr;
+    gmpu::api::guarded(nullptr, [&] {
+        p = mesh && !mesh->mesh.colors.empty() ? mesh->mesh.colors.data() : nullptr;
+    });
+    return p;
+}
+
+GMPU_API gmpu_status gmpu_mesh_color_from_points(const gmpu_mesh *mesh, const gmpu_points *points, gmpu_mesh **out) {
+    using gmpu::Error;
+    return gmpu::api::guarded(nullptr, [&] {
+        gmpu::api::require_arg(out, "out");
+        *out = nullptr;
+        gmpu::api::require_arg(mesh, "mesh");
+        gmpu::api::require_arg(points, "points");
+        const gmpu::io::PointCloud &cloud = points->cloud;
+        if (cloud.colors.empty() || cloud.colors.size() != 3 * cloud.size())
+            throw Error(GMPU_ERROR_INVALID_ARGUMENT, "the points have no colours (a .ply file with uchar red green blue)");
+        auto result = std::make_unique<gmpu_mesh>();
+        result->mesh = mesh->mesh;
+        gmpu::transfer_colours(result->mesh, cloud.positions.data(), cloud.colors.data(), cloud.size());
+        *out = result.release();
     });
 }
 
@@ -137,6 +190,7 @@ GMPU_API gmpu_status gmpu_mesh_write(const gmpu_mesh *mesh, const char *path) {
         // A mesh's normals are per vertex; without a full set, write none.
         view.normals = m.normals.size() == m.vertices.size() && !m.normals.empty() ? m.normals.data() : nullptr;
         view.confidence = m.confidence.size() == m.vertex_count() && !m.confidence.empty() ? m.confidence.data() : nullptr;
+        view.colors = m.colors.size() == m.vertices.size() && !m.colors.empty() ? m.colors.data() : nullptr;
         gmpu::io::write_mesh(path, view);
     });
 }

@@ -53,8 +53,8 @@ GMPU_API gmpu_status gmpu_points_read(const char *path, gmpu_points **out) {
     return gmpu_points_read_with(path, 0.0, nullptr, nullptr, out);
 }
 
-GMPU_API gmpu_status gmpu_points_create(const double *xyz, const double *normals, size_t count,
-                                        gmpu_points **out) {
+GMPU_API gmpu_status gmpu_points_create_with(const double *xyz, const double *normals, const uint8_t *colors,
+                                             size_t count, gmpu_points **out) {
     return gmpu::api::guarded(nullptr, [&] {
         gmpu::api::require_arg(out, "out");
         *out = nullptr;
@@ -65,8 +65,14 @@ GMPU_API gmpu_status gmpu_points_create(const double *xyz, const double *normals
         auto points = std::make_unique<gmpu_points>();
         copy_finite(points->cloud.positions, xyz, count, "coordinate");
         if (normals) copy_finite(points->cloud.normals, normals, count, "normal");
+        if (colors) points->cloud.colors.assign(colors, colors + 3 * count);
         *out = points.release();
     });
+}
+
+GMPU_API gmpu_status gmpu_points_create(const double *xyz, const double *normals, size_t count,
+                                        gmpu_points **out) {
+    return gmpu_points_create_with(xyz, normals, nullptr, count, out);
 }
 
 GMPU_API void gmpu_points_destroy(gmpu_points *points) {
@@ -89,6 +95,14 @@ GMPU_API const double *gmpu_points_normals(const gmpu_points *points) {
     const double *p = nullptr;
     gmpu::api::guarded(nullptr, [&] {
         p = points && !points->cloud.normals.empty() ? points->cloud.normals.data() : nullptr;
+    });
+    return p;
+}
+
+GMPU_API const uint8_t *gmpu_points_colors(const gmpu_points *points) {
+    const uint8_t *p = nullptr;
+    gmpu::api::guarded(nullptr, [&] {
+        p = points && !points->cloud.colors.empty() ? points->cloud.colors.data() : nullptr;
     });
     return p;
 }

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numeric>
 #include <string>
+#include <thread>
 
 #include "core/memory_budget.hpp"
 #include "core/parallel.hpp"
@@ -44,6 +45,19 @@ struct Builder {
     Workers &workers;
     Progress &progress;
     Octree tree;
+    // Progress inside a level, counted in points: near the root a level has a few cells that
+    // each take long, so the bar also moves as their children are fitted, by the share of
+    // the level's points whose child is done. Reported from the calling thread only.
+    std::thread::id caller = std::this_thread::get_id();
+    Progress *level_progress = nullptr;
+    double level_points = 1.0;
+    mutable std::atomic<uint64_t> level_fitted{0};
+
+    void report_work() const {
+        if (level_progress && std::this_thread::get_id() == caller)
+            level_progress->report(double(level_fitted.load(std::memory_order_relaxed)) / level_points);
+        progress.tick();
+    }
 
     double support_radius(double size) const { return params.support_scale * std::sqrt(3.0) * size; }
 
@@ -56,7 +70,7 @@ struct Builder {
     // cube is empty (the cell is not created).
     bool fit(Cell &c, bool cube_has_points, PiecewiseShape &piece) const {
         // Near the root one cell's children take tens of milliseconds: report between fits.
-        progress.tick();
+        report_work();
         thread_local std::vector<uint32_t> idx;
         thread_local std::vector<float> d2;
         thread_local PointList support;
@@ -97,6 +111,7 @@ struct Builder {
             c.shape.piece = -2;  // resolved to a table index when appended (single-threaded)
             piece = f.piece;
         }
+        level_fitted.fetch_add(c.point_end - c.point_begin, std::memory_order_relaxed);
         return true;
     }
 
@@ -156,6 +171,18 @@ struct Builder {
         tree.cells.push_back(std::move(c));
     }
 
+    // Levels still to make, this one included: a level's work is about the same at every depth
+    // (each unsettled point is in a support or two per level), so the bar is shared among
+    // them. Splitting a surface's cell spreads its points over about 4 children, and cells
+    // stop splitting near GMPU_PARAM_MIN_POINTS points.
+    double expected_levels(const std::vector<uint32_t> &level, double settled) const {
+        const double unsettled = std::max(1.0, (1.0 - settled) * double(points.size()));
+        const double per_cell = unsettled / double(level.size());
+        const double by_points = std::max(1.0, std::ceil(std::log(per_cell / params.min_points) / std::log(4.0)));
+        const double by_depth = std::max(1.0, double(params.max_depth) - double(tree.cells[level[0]].depth));
+        return std::min(by_points, by_depth);
+    }
+
     [[noreturn]] void too_many_cells() const {
         throw Error(GMPU_ERROR_LIMIT_EXCEEDED, "the octree needs more than GMPU_PARAM_MAX_CELLS = " +
                                                    std::to_string(uint64_t(params.max_cells)) +
@@ -184,23 +211,33 @@ struct Builder {
         std::vector<uint32_t> level;
         if (should_subdivide(tree.cells[0])) level.push_back(0);
         double settled = level.empty() ? 1.0 : 0.0;  // share of points already in leaves
+        double done = 0.0;                             // the progress bar's top so far
 
         while (!level.empty()) {
             std::vector<std::vector<Child>> kids(level.size());
-            // Map this level onto the unsettled part of the progress bar.
-            const double span = std::max(1e-9, (1.0 - settled) * 0.5);
-            Progress level_progress = progress.slice(settled, settled + span);
+            // Each level continues the bar where the previous one stopped, and takes the
+            // share of what is left that one of the levels still expected gets, with one
+            // share kept back: 1 means done, and more levels than expected may follow.
+            const double span = (1.0 - done) / (expected_levels(level, settled) + 1.0);
+            Progress this_level = progress.slice(done, done + span);
+            done += span;
+            level_points = 0.0;
+            for (uint32_t parent : level) level_points += tree.cells[parent].point_end - tree.cells[parent].point_begin;
+            level_points = std::max(1.0, level_points);
+            level_fitted = 0;
+            level_progress = &this_level;
             // The cap is checked as children are made, not once the level is done: a level can
             // hold most of the octree, and would otherwise overshoot the cap up to 8-fold.
             std::atomic<size_t> made{tree.cells.size()};
             // One cell per chunk: near the root a cell's fit takes tens of milliseconds, and
             // the caller reports progress (and sees a cancel) only between chunks.
-            parallel_for(0, level.size(), workers, level_progress, [&](size_t i) {
+            parallel_for(0, level.size(), workers, this_level, [&](size_t i) {
                 kids[i] = make_children(tree.cells[level[i]]);
                 const double cells = double(made += kids[i].size());
                 if (cells > params.max_cells) too_many_cells();
                 check_fit_memory(n, cells, params.max_memory);
             }, 1);
+            level_progress = nullptr;
             progress.throw_if_cancelled();
 
             std::vector<uint32_t> next;
@@ -226,7 +263,7 @@ struct Builder {
             }
             if (double(tree.cells.size()) > params.max_cells) too_many_cells();
             level.swap(next);
-            progress.report(settled);
+            progress.report(done);
         }
         // Subtree radius, children before parents (they come later in the array).
         for (size_t i = tree.cells.size(); i-- > 0;) {

@@ -221,6 +221,7 @@ PointCloud read_points(const std::string &path, const ReadOptions &options) {
     PointCloud cloud;
     cloud.positions = std::move(parsed.positions);
     cloud.normals = std::move(parsed.normals);
+    cloud.colors = std::move(parsed.colors);
     return cloud;
 }
 

@@ -23,6 +23,7 @@ namespace detail {
 struct Parsed {
     std::vector<double> positions;   // 3 per vertex
     std::vector<double> normals;     // 3 per vertex, or empty
+    std::vector<uint8_t> colors;     // red green blue per vertex (PLY only), or empty
     std::vector<uint32_t> triangles; // 3 per triangle; filled only for Want::mesh
 };
 

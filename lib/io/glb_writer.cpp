@@ -1,6 +1,6 @@
 // glTF 2.0 binary (.glb): one scene, one node, one triangle mesh. The 12-byte header, a JSON
 // chunk describing the mesh, and a BIN chunk holding float32 positions, float32 unit normals
-// (when the mesh has them) and uint32 indices, each 4-byte aligned as the format requires.
+// (when the mesh has them), float32 linear colours COLOR_0 (when it has them) and uint32 indices, each 4-byte aligned as the format requires.
 // Positions get the min/max the specification demands, taken from the float32 values
 // actually stored. A mesh without triangles is written as a valid file with an empty scene.
 #include <array>
@@ -36,8 +36,14 @@ void unit(const double *n, float out[3]) {
     for (size_t k = 0; k < 3; ++k) out[k] = length > 0 ? static_cast<float>(n[k] / length) : (k == 2 ? 1.0f : 0.0f);
 }
 
+// glTF colours are linear; PLY colours (as every 8-bit image) are sRGB-encoded.
+float linear_of_srgb(uint8_t c) {
+    const double x = c / 255.0;
+    return static_cast<float>(x <= 0.04045 ? x / 12.92 : std::pow((x + 0.055) / 1.055, 2.4));
+}
+
 std::string json_of(const MeshView &mesh, const float lo[3], const float hi[3], size_t positions_bytes,
-                    size_t normals_bytes, size_t indices_bytes) {
+                    size_t normals_bytes, size_t colors_bytes, size_t indices_bytes) {
     const std::string n = std::to_string(mesh.vertex_count);
     std::string accessors = "{\"bufferView\":0,\"componentType\":5126,\"count\":" + n +
                             ",\"type\":\"VEC3\",\"min\":" + vec3(lo) + ",\"max\":" + vec3(hi) + "}";
@@ -52,7 +58,16 @@ std::string json_of(const MeshView &mesh, const float lo[3], const float hi[3], 
                  ",\"byteLength\":" + std::to_string(normals_bytes) + ",\"target\":34962}";
         attributes += ",\"NORMAL\":1";
         offset += normals_bytes;
-        next = 2;
+        ++next;
+    }
+    if (mesh.colors) {
+        const std::string view = std::to_string(next);
+        accessors += ",{\"bufferView\":" + view + ",\"componentType\":5126,\"count\":" + n + ",\"type\":\"VEC3\"}";
+        views += ",{\"buffer\":0,\"byteOffset\":" + std::to_string(offset) +
+                 ",\"byteLength\":" + std::to_string(colors_bytes) + ",\"target\":34962}";
+        attributes += ",\"COLOR_0\":" + view;
+        offset += colors_bytes;
+        ++next;
     }
     const std::string index = std::to_string(next);
     accessors += ",{\"bufferView\":" + index + ",\"componentType\":5125,\"count\":" +
@@ -79,9 +94,10 @@ void write_glb(AtomicFile &out, const MeshView &mesh) {
     const size_t positions_bytes = empty ? 0 : 12 * mesh.vertex_count;
     const size_t normals_bytes = empty || !mesh.normals ? 0 : 12 * mesh.vertex_count;
     const size_t indices_bytes = empty ? 0 : 12 * mesh.triangle_count;
-    const size_t bin_bytes = positions_bytes + normals_bytes + indices_bytes;
+    const size_t colors_bytes = empty || !mesh.colors ? 0 : 12 * mesh.vertex_count;
+    const size_t bin_bytes = positions_bytes + normals_bytes + colors_bytes + indices_bytes;
     // The file's length is a uint32; the JSON is far below the margin left for it.
-    if (mesh.vertex_count > UINT32_MAX / 24 || mesh.triangle_count > UINT32_MAX / 24 ||
+    if (mesh.vertex_count > UINT32_MAX / 36 || mesh.triangle_count > UINT32_MAX / 24 ||
         bin_bytes > UINT32_MAX - (size_t{1} << 20))
         fail(GMPU_ERROR_INVALID_INPUT, out.path(), "mesh too large for a .glb file (4 GiB at most)");
 
@@ -94,7 +110,7 @@ void write_glb(AtomicFile &out, const MeshView &mesh) {
         }
     std::string json = empty ? std::string("{\"asset\":{\"version\":\"2.0\",\"generator\":\"gmpu\"},"
                                            "\"scene\":0,\"scenes\":[{\"nodes\":[]}]}")
-                             : json_of(mesh, lo, hi, positions_bytes, normals_bytes, indices_bytes);
+                             : json_of(mesh, lo, hi, positions_bytes, normals_bytes, colors_bytes, indices_bytes);
     json.append((4 - json.size() % 4) % 4, ' ');  // chunks are 4-byte aligned; JSON pads with spaces
 
     const size_t total = 12 + 8 + json.size() + (empty ? 0 : 8 + bin_bytes);
@@ -120,6 +136,12 @@ void write_glb(AtomicFile &out, const MeshView &mesh) {
             unit(mesh.normals + 3 * i, n);
             char *p = record;
             for (float x : n) p = put_le(p, x);
+            out.write(record, sizeof record);
+        }
+    if (mesh.colors)
+        for (size_t i = 0; i < mesh.vertex_count; ++i) {
+            char *p = record;
+            for (size_t k = 0; k < 3; ++k) p = put_le(p, linear_of_srgb(mesh.colors[3 * i + k]));
             out.write(record, sizeof record);
         }
     for (size_t t = 0; t < mesh.triangle_count; ++t) {

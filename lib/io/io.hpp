@@ -26,6 +26,7 @@ struct ReadOptions {
 struct PointCloud {
     std::vector<double> positions;  // 3 per point
     std::vector<double> normals;    // 3 per point, or empty when the file has none
+    std::vector<uint8_t> colors;    // red green blue per point (0..255), or empty
     size_t size() const { return positions.size() / 3; }
 };
 
@@ -42,6 +43,7 @@ struct MeshView {
     size_t triangle_count = 0;
     const double *normals = nullptr;
     const double *confidence = nullptr;  // per vertex; written by .ply only (float property)
+    const uint8_t *colors = nullptr;     // red green blue per vertex: .ply (uchar), .glb (COLOR_0)
 };
 
 // .ply (ascii, binary_little_endian, binary_big_endian), .xyz/.txt (3 or 6 columns),

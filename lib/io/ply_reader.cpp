@@ -1,6 +1,7 @@
 // PLY 1.0 reader: ascii, binary_little_endian and binary_big_endian bodies, any scalar
 // type, any extra elements and properties (skipped). Only the `vertex` element's
-// x y z [nx ny nz] and, for meshes, the `face` element's vertex_indices are decoded.
+// x y z [nx ny nz] [red green blue, uchar] and, for meshes, the `face` element's
+// vertex_indices are decoded.
 //
 // Hostile input: element counts come from the header and are never trusted. Elements of
 // fixed-size records are bounds-checked (count × record ≤ bytes left) before anything is
@@ -207,9 +208,12 @@ double load_scalar(const unsigned char *p, Scalar t, bool swap) {
 // The fields a reader wants from one element: the property index whose value goes to
 // out[k], or -1.
 struct Wanted {
-    int prop[6] = {-1, -1, -1, -1, -1, -1};
-    size_t n = 0;  // how many of prop[] are used
+    int prop[9] = {-1, -1, -1, -1, -1, -1, -1, -1, -1};
+    size_t n = 0;  // how many of prop[] are used (unfound ones stay -1)
 };
+
+// Vertex slots: x y z, then nx ny nz, then red green blue.
+constexpr size_t kNormalSlot = 3, kColourSlot = 6;
 
 class Body {
 public:
@@ -343,8 +347,8 @@ bool Body::record(const Element &e, const Wanted &w, double *out, int list_prop,
 
 void Body::vertices(const Element &e, Parsed &out) {
     Wanted w;
-    const char *names[] = {"x", "y", "z", "nx", "ny", "nz"};
-    for (size_t k = 0; k < 6; ++k) {
+    const char *names[] = {"x", "y", "z", "nx", "ny", "nz", "red", "green", "blue"};
+    for (size_t k = 0; k < 9; ++k) {
         w.prop[k] = e.find(names[k]);
         if (w.prop[k] >= 0 && e.props[static_cast<size_t>(w.prop[k])].is_list)
             fail(GMPU_ERROR_PARSE, name_, "vertex property '" + std::string(names[k]) + "' is a list");
@@ -355,7 +359,22 @@ void Body::vertices(const Element &e, Parsed &out) {
     const int normals = (w.prop[3] >= 0) + (w.prop[4] >= 0) + (w.prop[5] >= 0);
     if (normals != 0 && normals != 3)
         fail(GMPU_ERROR_PARSE, name_, "the vertex element has some but not all of nx ny nz");
-    w.n = normals ? 6 : 3;
+    // Colours are kept only as the common layout has them (all three, uchar); any other is
+    // skipped like an unknown property.
+    bool colours = true;
+    for (size_t k = kColourSlot; k < 9; ++k)
+        colours = colours && w.prop[k] >= 0 && e.props[static_cast<size_t>(w.prop[k])].type == Scalar::u8;
+    if (!colours)
+        for (size_t k = kColourSlot; k < 9; ++k) w.prop[k] = -1;
+    const bool has_normals = normals != 0;
+    w.n = colours ? 9 : has_normals ? 6 : 3;
+    const auto keep = [&](const double *v) {
+        out.positions.insert(out.positions.end(), v, v + 3);
+        if (has_normals) out.normals.insert(out.normals.end(), v + kNormalSlot, v + kNormalSlot + 3);
+        if (colours)
+            for (size_t k = kColourSlot; k < 9; ++k)  // ascii may hold anything: out of range is 0
+                out.colors.push_back(v[k] >= 0.0 && v[k] <= 255.0 ? static_cast<uint8_t>(v[k]) : 0);
+    };
 
     const bool ascii = h_.encoding == Encoding::ascii;
     if (!ascii && !e.has_lists()) {
@@ -363,23 +382,25 @@ void Body::vertices(const Element &e, Parsed &out) {
         const size_t rec = e.min_record_size();
         if (e.count > left() / rec) truncated(e, left() / rec);
         const size_t n = static_cast<size_t>(e.count);
-        size_t offset[6];
-        Scalar type[6];
+        size_t offset[9];
+        Scalar type[9];
         for (size_t k = 0; k < w.n; ++k) {
             offset[k] = 0;
+            if (w.prop[k] < 0) continue;
             for (int pi = 0; pi < w.prop[k]; ++pi) offset[k] += size_of(e.props[static_cast<size_t>(pi)].type);
             type[k] = e.props[static_cast<size_t>(w.prop[k])].type;
         }
         // Reserved, then filled record by record: the pages are touched as the ticks go.
         out.positions.reserve(3 * n);
-        if (w.n == 6) out.normals.reserve(3 * n);
-        double v[6];
+        if (has_normals) out.normals.reserve(3 * n);
+        if (colours) out.colors.reserve(3 * n);
+        double v[9];
         for (size_t i = 0; i < n; ++i) {
             tick(i, i * rec);
             const unsigned char *r = p_ + i * rec;
-            for (size_t k = 0; k < w.n; ++k) v[k] = load_scalar(r + offset[k], type[k], swap_);
-            out.positions.insert(out.positions.end(), v, v + 3);
-            if (w.n == 6) out.normals.insert(out.normals.end(), v + 3, v + 6);
+            for (size_t k = 0; k < w.n; ++k)
+                if (w.prop[k] >= 0) v[k] = load_scalar(r + offset[k], type[k], swap_);
+            keep(v);
         }
         p_ += n * rec;
         return;
@@ -391,13 +412,13 @@ void Body::vertices(const Element &e, Parsed &out) {
     const size_t cap = (ascii ? tokens_.remaining() + 1 : left()) / min_bytes;
     const size_t reserve = static_cast<size_t>(std::min<uint64_t>(e.count, cap));
     out.positions.reserve(3 * reserve);
-    if (w.n == 6) out.normals.reserve(3 * reserve);
-    double v[6];
+    if (has_normals) out.normals.reserve(3 * reserve);
+    if (colours) out.colors.reserve(3 * reserve);
+    double v[9];
     for (uint64_t i = 0; i < e.count; ++i) {
         tick(i);
         record(e, w, v, -1, i, [](uint64_t) {});
-        out.positions.insert(out.positions.end(), v, v + 3);
-        if (w.n == 6) out.normals.insert(out.normals.end(), v + 3, v + 6);
+        keep(v);
     }
 }
 

@@ -1,5 +1,5 @@
 // PLY output: binary little-endian, double x y z (so a write → read round trip is exact),
-// optional double nx ny nz, optional float confidence, and for meshes `element face` with `list uchar int
+// optional double nx ny nz, optional float confidence, optional uchar red green blue, and for meshes `element face` with `list uchar int
 // vertex_indices` (the most widely read layout).
 #include <cstring>
 #include <string>
@@ -32,6 +32,7 @@ void write_ply(AtomicFile &out, const MeshView &mesh, bool faces) {
     if (mesh.normals) header += "property double nx\nproperty double ny\nproperty double nz\n";
     // Float: a confidence is a ratio of distances, read by viewers as a scalar colour map.
     if (mesh.confidence) header += "property float confidence\n";
+    if (mesh.colors) header += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
     if (faces)
         header += "element face " + std::to_string(mesh.triangle_count) +
                   "\nproperty list uchar int vertex_indices\n";
@@ -45,6 +46,8 @@ void write_ply(AtomicFile &out, const MeshView &mesh, bool faces) {
         if (mesh.normals)
             for (size_t k = 0; k < 3; ++k) p = put_le(p, mesh.normals[3 * i + k]);
         if (mesh.confidence) p = put_le(p, static_cast<float>(mesh.confidence[i]));
+        if (mesh.colors)
+            for (size_t k = 0; k < 3; ++k) *p++ = static_cast<char>(mesh.colors[3 * i + k]);
         out.write(record, static_cast<size_t>(p - record));
     }
     if (!faces) return;

@@ -49,6 +49,8 @@ Mesh trim_unsupported(const Mesh &mesh, double threshold) {
                 out.vertices.insert(out.vertices.end(), mesh.vertices.begin() + 3 * v, mesh.vertices.begin() + 3 * v + 3);
                 if (normals) out.normals.insert(out.normals.end(), mesh.normals.begin() + 3 * v, mesh.normals.begin() + 3 * v + 3);
                 out.confidence.push_back(mesh.confidence[v]);
+                if (!mesh.colors.empty())
+                    out.colors.insert(out.colors.end(), mesh.colors.begin() + 3 * v, mesh.colors.begin() + 3 * v + 3);
             }
             out.triangles.push_back(index[v]);
         }

@@ -30,10 +30,13 @@ Mesh welded(const Mesh &in) {
     Mesh out;
     out.vertices.resize(3 * unique);
     if (!in.confidence.empty()) out.confidence.resize(unique);
+    if (!in.colors.empty()) out.colors.resize(3 * unique);
     for (size_t v = 0; v < n; ++v) {
         if (remap[v] == ~0u) continue;
         for (int d = 0; d < 3; ++d) out.vertices[3 * remap[v] + d] = in.vertices[3 * v + d];
         if (!in.confidence.empty()) out.confidence[remap[v]] = in.confidence[v];
+        if (!in.colors.empty())
+            for (int d = 0; d < 3; ++d) out.colors[3 * remap[v] + d] = in.colors[3 * v + d];
     }
     out.triangles.reserve(in.triangles.size());
     for (size_t t = 0; t < in.triangles.size(); t += 3) {
@@ -54,6 +57,8 @@ Mesh compacted(const Mesh &base, const std::vector<uint32_t> &triangles) {
             index[v] = uint32_t(out.vertices.size() / 3);
             out.vertices.insert(out.vertices.end(), base.vertices.begin() + 3 * v, base.vertices.begin() + 3 * v + 3);
             if (!base.confidence.empty()) out.confidence.push_back(base.confidence[v]);
+            if (!base.colors.empty())
+                out.colors.insert(out.colors.end(), base.colors.begin() + 3 * v, base.colors.begin() + 3 * v + 3);
         }
         out.triangles.push_back(index[v]);
     }

@@ -396,6 +396,120 @@ static void test_mesh_write(void **state) {
     gmpu_mesh_destroy(m);
 }
 
+/* A mesh built from arrays keeps what the arrays give: normals (made unit), confidence and
+ * colours are written to .ply and read back. */
+static void test_mesh_create_with_attributes(void **state) {
+    (void)state;
+    const double normals[12] = {0, 0, -2, 0, 0, 3, 1, 0, 0, 0, 0.5, 0};
+    const double confidence[4] = {0.25, 1, 2, INFINITY};
+    const uint8_t colors[12] = {255, 0, 0, 0, 255, 0, 0, 0, 255, 10, 20, 30};
+    gmpu_mesh *m = NULL;
+    assert_int_equal(gmpu_mesh_create_with(tet, 4, tet_faces, 4, normals, confidence, colors, &m), GMPU_OK);
+    const double *n = gmpu_mesh_normals(m);
+    assert_non_null(n);
+    const double unit[12] = {0, 0, -1, 0, 0, 1, 1, 0, 0, 0, 1, 0};
+    for (int i = 0; i < 12; ++i) assert_true(n[i] == unit[i]);
+    assert_memory_equal(gmpu_mesh_confidence(m), confidence, sizeof confidence);
+    assert_memory_equal(gmpu_mesh_colors(m), colors, sizeof colors);
+    const char *path = scratch_path("attributes.ply");
+    assert_int_equal(gmpu_mesh_write(m, path), GMPU_OK);
+    gmpu_points *p = NULL;
+    assert_int_equal(gmpu_points_read(path, &p), GMPU_OK);
+    assert_memory_equal(gmpu_points_positions(p), tet, sizeof tet);
+    assert_non_null(gmpu_points_normals(p));
+    assert_memory_equal(gmpu_points_normals(p), unit, sizeof unit);
+    assert_non_null(gmpu_points_colors(p));
+    assert_memory_equal(gmpu_points_colors(p), colors, sizeof colors);
+    gmpu_points_destroy(p);
+    /* Simplify and trim carry the colours. */
+    gmpu_mesh *t = NULL;
+    assert_int_equal(gmpu_mesh_trim(m, 2.5, &t), GMPU_OK); /* keeps triangle 0 1 2: vertex 3 is +inf */
+    assert_int_equal(gmpu_mesh_triangle_count(t), 1);
+    assert_memory_equal(gmpu_mesh_colors(t), colors, 9);
+    gmpu_mesh_destroy(t);
+    gmpu_mesh_destroy(m);
+
+    /* Without the optional arrays it is gmpu_mesh_create. */
+    assert_int_equal(gmpu_mesh_create_with(tet, 4, tet_faces, 4, NULL, NULL, NULL, &m), GMPU_OK);
+    assert_null(gmpu_mesh_normals(m));
+    assert_null(gmpu_mesh_confidence(m));
+    assert_null(gmpu_mesh_colors(m));
+    gmpu_mesh_destroy(m);
+    assert_null(gmpu_mesh_colors(NULL));
+
+    m = (gmpu_mesh *)&m;
+    const double zero_normal[12] = {0, 0, 1, 0, 0, 1, 0, 0, 0, 0, 0, 1};
+    check_failure(gmpu_mesh_create_with(tet, 4, tet_faces, 4, zero_normal, NULL, NULL, &m), GMPU_ERROR_INVALID_INPUT,
+                  "normal of vertex 2");
+    assert_null(m);
+    const double bad_confidence[4] = {0, -1, 0, 0};
+    check_failure(gmpu_mesh_create_with(tet, 4, tet_faces, 4, NULL, bad_confidence, NULL, &m),
+                  GMPU_ERROR_INVALID_INPUT, "confidence of vertex 1");
+    assert_null(m);
+}
+
+/* PLY colours (uchar red green blue) are read, given to a mesh's vertices from the nearest
+ * point, and written back out; other colour layouts are skipped like unknown properties. */
+static void test_point_colours(void **state) {
+    (void)state;
+    const char *path = scratch_path("coloured.ply");
+    put(path, "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+              "property uchar red\nproperty uchar green\nproperty uchar blue\nproperty uchar alpha\nend_header\n"
+              "0 0 0 255 0 0 9\n1 0 0 0 255 0 9\n0 1 0 0 0 255 9\n0 0 1 10 20 30 9\n");
+    gmpu_points *p = NULL;
+    assert_int_equal(gmpu_points_read(path, &p), GMPU_OK);
+    const uint8_t expected[12] = {255, 0, 0, 0, 255, 0, 0, 0, 255, 10, 20, 30};
+    const double corners[12] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1};
+    assert_non_null(gmpu_points_colors(p));
+    assert_memory_equal(gmpu_points_colors(p), expected, sizeof expected);
+    assert_memory_equal(gmpu_points_positions(p), corners, sizeof corners);
+
+    /* Each vertex of a mesh near the points takes its nearest point's colour. */
+    const double near[12] = {0.1, 0.1, 0.1, 0.9, 0.1, 0, 0, 0.8, 0.1, 0, 0.1, 0.7};
+    gmpu_mesh *m = NULL, *coloured = NULL;
+    assert_int_equal(gmpu_mesh_create(near, 4, tet_faces, 4, &m), GMPU_OK);
+    assert_int_equal(gmpu_mesh_color_from_points(m, p, &coloured), GMPU_OK);
+    assert_null(gmpu_mesh_colors(m)); /* the input is untouched */
+    assert_memory_equal(gmpu_mesh_colors(coloured), expected, sizeof expected);
+    const char *out = scratch_path("coloured_mesh.ply");
+    assert_int_equal(gmpu_mesh_write(coloured, out), GMPU_OK);
+    gmpu_points *back = NULL;
+    assert_int_equal(gmpu_points_read(out, &back), GMPU_OK);
+    assert_memory_equal(gmpu_points_colors(back), expected, sizeof expected);
+    gmpu_points_destroy(back);
+    gmpu_mesh *simple = NULL;
+    assert_int_equal(gmpu_mesh_simplify(coloured, 0, 0.0, &simple), GMPU_OK);
+    assert_non_null(gmpu_mesh_colors(simple));
+    gmpu_mesh_destroy(simple);
+
+    /* Points without colours cannot colour a mesh. */
+    gmpu_points *plain = NULL;
+    gmpu_mesh *none = (gmpu_mesh *)&none;
+    assert_int_equal(gmpu_points_create(tet, NULL, 4, &plain), GMPU_OK);
+    assert_null(gmpu_points_colors(plain));
+    check_failure(gmpu_mesh_color_from_points(m, plain, &none), GMPU_ERROR_INVALID_ARGUMENT, "no colours");
+    assert_null(none);
+    gmpu_points_destroy(plain);
+    /* ...but points made with colours can. */
+    assert_int_equal(gmpu_points_create_with(corners, NULL, expected, 4, &plain), GMPU_OK);
+    assert_memory_equal(gmpu_points_colors(plain), expected, sizeof expected);
+    gmpu_mesh_destroy(coloured);
+    assert_int_equal(gmpu_mesh_color_from_points(m, plain, &coloured), GMPU_OK);
+    assert_memory_equal(gmpu_mesh_colors(coloured), expected, sizeof expected);
+    gmpu_points_destroy(plain);
+    gmpu_mesh_destroy(coloured);
+    gmpu_mesh_destroy(m);
+    gmpu_points_destroy(p);
+
+    /* Float colours are not the common layout: skipped, the points still read. */
+    put(path, "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+              "property float red\nproperty float green\nproperty float blue\nend_header\n"
+              "0 0 0 1 0 0\n1 0 0 0 1 0\n0 1 0 0 0 1\n0 0 1 .1 .2 .3\n");
+    assert_int_equal(gmpu_points_read(path, &p), GMPU_OK);
+    assert_null(gmpu_points_colors(p));
+    gmpu_points_destroy(p);
+}
+
 static void test_repository_data(void **state) {
     (void)state;
     const char *root = getenv("GMPU_TEST_DATA");
@@ -436,6 +550,8 @@ int main(void) {
         cmocka_unit_test(test_mesh_create_and_access),
         cmocka_unit_test(test_mesh_create_errors),
         cmocka_unit_test(test_mesh_write),
+        cmocka_unit_test(test_mesh_create_with_attributes),
+        cmocka_unit_test(test_point_colours),
         cmocka_unit_test(test_repository_data),
     };
     return cmocka_run_group_tests(tests, setup, teardown);

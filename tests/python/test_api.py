@@ -175,7 +175,7 @@ def test_mesh_write_reports_c_errors(tmp_path):
     m = gmpu.Mesh([[0, 0, 0], [1, 0, 0], [np.nan, 1, 0]], [[0, 1, 2]])
     with pytest.raises(gmpu.InvalidInputError, match="vertex 2 is not finite") as e:
         m.write(tmp_path / "x.ply")
-    assert e.value.status_name == "GMPU_ERROR_INVALID_INPUT" and e.value.function == "gmpu_mesh_create"
+    assert e.value.status_name == "GMPU_ERROR_INVALID_INPUT" and e.value.function == "gmpu_mesh_create_with"
     ok = gmpu.Mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]])
     with pytest.raises(gmpu.UnsupportedError):
         ok.write(tmp_path / "x.wrl")
@@ -246,7 +246,7 @@ def test_context_manager_and_close(small_cloud):
 
 
 def test_stage_enum():
-    assert [int(s) for s in gmpu.Stage] == [1, 2, 3]
+    assert [int(s) for s in gmpu.Stage] == [1, 2, 3, 4]
     assert str(gmpu.Stage.POLYGONIZE) == "polygonize"
 
 

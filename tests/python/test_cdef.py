@@ -120,6 +120,14 @@ def test_every_status_has_its_exception_class_and_every_stage_its_enum():
     statuses = {k for k in ffi.typeof("gmpu_status").relements if k != "GMPU_OK"}
     assert statuses == set(ERROR_CLASSES)
     stages = {k[len("GMPU_STAGE_"):]: v for k, v in ffi.typeof("gmpu_stage").relements.items()}
-    # READ is reported by gmpu_points_read_with only, which this binding does not wrap.
-    stages.pop("READ")
     assert stages == {s.name: int(s) for s in gmpu.Stage}
+
+
+def test_statistic_names_are_the_headers_enumerators():
+    """gmpu_stat_name (what the Node binding lists statistics by) names every gmpu_stat key,
+    1..gmpu_stat_count() without gaps, as the enumerator's lower-case suffix."""
+    enum = {v: k[len("GMPU_STAT_"):].lower() for k, v in ffi.typeof("gmpu_stat").relements.items()}
+    count = lib.gmpu_stat_count()
+    assert sorted(enum) == list(range(1, count + 1))
+    assert {k: ffi.string(lib.gmpu_stat_name(k)).decode() for k in range(1, count + 1)} == enum
+    assert lib.gmpu_stat_name(0) == ffi.NULL and lib.gmpu_stat_name(count + 1) == ffi.NULL

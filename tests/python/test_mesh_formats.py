@@ -21,6 +21,7 @@ for path in sys.argv[1:]:
         "vertices": np.asarray(m.vertices).tolist(),
         "triangles": np.asarray(m.triangles).tolist(),
         "vertex_normals": np.asarray(m.vertex_normals).tolist(),
+        "vertex_colors": np.asarray(m.vertex_colors).tolist(),
     }
 print(json.dumps(out))
 """

@@ -19,8 +19,8 @@ def test_progress_reports_every_stage_in_order(small_cloud):
     assert len(mesh.faces) > 0
     stages = [st for st, _ in calls]
     assert all(isinstance(st, gmpu.Stage) for st in stages)
-    assert stages == sorted(stages) and set(stages) == set(gmpu.Stage)
-    for stage in gmpu.Stage:
+    assert stages == sorted(stages) and set(stages) == set(gmpu.Stage) - {gmpu.Stage.READ}
+    for stage in set(gmpu.Stage) - {gmpu.Stage.READ}:
         fr = [f for st, f in calls if st == stage]
         assert fr[0] == 0.0 and fr[-1] == 1.0
         assert all(0.0 <= a <= b <= 1.0 for a, b in zip(fr, fr[1:]))

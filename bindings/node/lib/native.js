@@ -93,6 +93,8 @@ function declare(lib) {
         param_count: f('int', 'gmpu_param_count', []),
         param_info: f('int', 'gmpu_param_info', ['int', koffi.out(koffi.pointer(paramInfo))]),
         param_key: f('int', 'gmpu_param_key', ['const char *']),
+        stat_count: f('int', 'gmpu_stat_count', []),
+        stat_name: f('const char *', 'gmpu_stat_name', ['int']),
 
         surface_create: f('int', 'gmpu_surface_create', [outPtr]),
         surface_destroy: f('void', 'gmpu_surface_destroy', ['void *']),
@@ -114,6 +116,10 @@ function declare(lib) {
         surface_polygonize: f('int', 'gmpu_surface_polygonize', ['void *', outPtr]),
 
         mesh_create: f('int', 'gmpu_mesh_create', ['double *', 'size_t', 'uint32_t *', 'size_t', outPtr]),
+        mesh_create_with: f('int', 'gmpu_mesh_create_with',
+            ['double *', 'size_t', 'uint32_t *', 'size_t', 'double *', 'double *', 'uint8_t *', outPtr]),
+        mesh_colors: f('void *', 'gmpu_mesh_colors', ['void *']),
+        mesh_color_from_points: f('int', 'gmpu_mesh_color_from_points', ['void *', 'void *', outPtr]),
         mesh_destroy: f('void', 'gmpu_mesh_destroy', ['void *']),
         mesh_vertex_count: f('size_t', 'gmpu_mesh_vertex_count', ['void *']),
         mesh_triangle_count: f('size_t', 'gmpu_mesh_triangle_count', ['void *']),
@@ -129,10 +135,12 @@ function declare(lib) {
         points_read_with: f('int', 'gmpu_points_read_with',
             ['const char *', 'double', koffi.pointer(progressProto), 'void *', outPtr]),
         points_create: f('int', 'gmpu_points_create', ['double *', 'double *', 'size_t', outPtr]),
+        points_create_with: f('int', 'gmpu_points_create_with', ['double *', 'double *', 'uint8_t *', 'size_t', outPtr]),
         points_destroy: f('void', 'gmpu_points_destroy', ['void *']),
         points_count: f('size_t', 'gmpu_points_count', ['void *']),
         points_positions: f('void *', 'gmpu_points_positions', ['void *']),
         points_normals: f('void *', 'gmpu_points_normals', ['void *']),
+        points_colors: f('void *', 'gmpu_points_colors', ['void *']),
         points_write: f('int', 'gmpu_points_write', ['void *', 'const char *']),
     };
 }
@@ -154,9 +162,9 @@ export function getNative() {
     return native;
 }
 
-/** Copies count values of a C array (T = 'double' | 'uint32_t') into a new typed array. */
+/** Copies count values of a C array (T = 'double' | 'uint32_t' | 'uint8_t') into a new typed array. */
 export function copyArray(ptr, type, count) {
-    if (count === 0) return type === 'double' ? new Float64Array(0) : new Uint32Array(0);
+    if (count === 0) return type === 'double' ? new Float64Array(0) : type === 'uint8_t' ? new Uint8Array(0) : new Uint32Array(0);
     if (ptr === null || ptr === 0n) return null;
     return koffi.decode(ptr, type, count);
 }

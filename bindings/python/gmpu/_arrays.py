@@ -94,6 +94,13 @@ def uint32_ptr(arr: np.ndarray):
     return _pointer(arr, "uint32_t")
 
 
+def uint8_ptr(arr: Optional[np.ndarray]):
+    """A uint8_t* into a C-contiguous uint8 array (NULL for None)."""
+    if arr is None:
+        return ffi.NULL
+    return _pointer(arr, "uint8_t")
+
+
 def view_of_c_memory(owner, ptr, shape: Tuple[int, ...], dtype) -> np.ndarray:
     """A read-only numpy view of library memory at ptr, keeping owner (a cffi cdata whose
     destructor frees that memory) alive for as long as the view or any view of it exists.

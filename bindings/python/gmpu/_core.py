@@ -11,15 +11,27 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from . import _mesh_facts
-from ._arrays import _as_real_array, double_ptr, queries_for_c, uint32_ptr, view_of_c_memory, xyz_for_c
+from ._arrays import _as_real_array, double_ptr, queries_for_c, uint8_ptr, uint32_ptr, view_of_c_memory, xyz_for_c
 from ._errors import check
 from ._library import ffi, lib
 from ._params import PARAM_INFO, PARAMS, param_value
-from ._progress import ProgressFn, run_with_progress
+from ._progress import ProgressFn, run_read_with_progress, run_with_progress
 
 __all__ = ["Surface", "Mesh", "Points", "reconstruct", "read_points", "PARAMS", "PARAM_INFO", "STATS"]
 
 PathLike = Union[str, "os.PathLike[str]"]
+
+
+def _colours(colors: Optional[ArrayLike], count: int) -> Optional[NDArray[np.uint8]]:
+    """Red green blue per vertex or point as a C-ordered count×3 uint8 array (None stays None)."""
+    if colors is None:
+        return None
+    c = np.asarray(colors)
+    if c.dtype != np.uint8:
+        raise ValueError(f"colors: expected dtype uint8 (0..255 red green blue), got {c.dtype}")
+    if c.shape != (count, 3):
+        raise ValueError(f"colors: expected shape {(count, 3)}, got {c.shape}")
+    return np.ascontiguousarray(c)
 
 
 def _enum_names(ctype: str, prefix: str) -> Dict[str, int]:
@@ -110,10 +122,12 @@ class Mesh:
     gives a writable copy; build ``Mesh(vertices, faces)`` from edited arrays.
     """
 
-    def __init__(self, vertices: ArrayLike, faces: ArrayLike, normals: Optional[ArrayLike] = None):
+    def __init__(self, vertices: ArrayLike, faces: ArrayLike, normals: Optional[ArrayLike] = None,
+                 confidence: Optional[ArrayLike] = None, colors: Optional[ArrayLike] = None):
         """Builds a mesh from arrays: vertices n×3 (real numbers; kept without copying when
         already C-ordered float64), faces m×3 (integers in [0, n); int32 or uint32 are kept
-        without copying), optional per-vertex normals n×3."""
+        without copying), optional per-vertex normals n×3, confidence (n) and colors (n×3
+        uint8), all kept by write, simplify and pickling."""
         v = _as_real_array(vertices, "vertices")
         if v.ndim != 2 or v.shape[1] != 3:
             raise ValueError(f"vertices: expected an n×3 array, got shape {v.shape}")
@@ -139,8 +153,14 @@ class Mesh:
             n = np.ascontiguousarray(_as_real_array(normals, "normals"), dtype=np.float64)
             if n.shape != v.shape:
                 raise ValueError(f"normals: expected shape {v.shape} (one per vertex), got {n.shape}")
+        c = None
+        if confidence is not None:
+            c = np.ascontiguousarray(_as_real_array(confidence, "confidence"), dtype=np.float64)
+            if c.shape != (len(v),):
+                raise ValueError(f"confidence: expected shape {(len(v),)} (one per vertex), got {c.shape}")
         self._vertices, self._faces, self._normals = v, f, n
-        self._confidence = None
+        self._confidence = c
+        self._colors = _colours(colors, len(v))
         self._handle = None  # the gmpu_mesh these arrays view, when made by the library
 
     @classmethod
@@ -157,6 +177,8 @@ class Mesh:
         self._normals = None if normals == ffi.NULL else view_of_c_memory(handle, normals, (nv, 3), np.float64)
         confidence = lib.gmpu_mesh_confidence(handle)
         self._confidence = None if confidence == ffi.NULL else view_of_c_memory(handle, confidence, (nv,), np.float64)
+        colors = lib.gmpu_mesh_colors(handle)
+        self._colors = None if colors == ffi.NULL else view_of_c_memory(handle, colors, (nv, 3), np.uint8)
         return self
 
     @property
@@ -178,8 +200,26 @@ class Mesh:
     def confidence(self) -> Optional[NDArray[np.float64]]:
         """n float64: each vertex's distance to the nearest input point in sample spacings
         (about 0.5 or less on sampled surface, several over a scan's holes), or None for a
-        mesh built from arrays."""
+        mesh built from arrays without one."""
         return self._confidence
+
+    @property
+    def colors(self) -> Optional[NDArray[np.uint8]]:
+        """n×3 uint8 red green blue per vertex, or None (see :meth:`color_from`)."""
+        return self._colors
+
+    def color_from(self, points: "Points") -> "Mesh":
+        """A copy whose every vertex takes the colour of the nearest of ``points`` (a
+        :class:`Points` with colors, as read_points gives a .ply with red green blue)."""
+        if not isinstance(points, Points) or points.colors is None:
+            raise ValueError("color_from: expected a gmpu.Points with colors")
+        out = ffi.new("gmpu_mesh **")
+
+        def call(handle):
+            points._with_c_points(lambda pts: check(lib.gmpu_mesh_color_from_points(handle, pts, out),
+                                                    "gmpu_mesh_color_from_points"))
+        self._with_c_mesh(call)
+        return Mesh._from_c(out[0])
 
     def _with_c_mesh(self, call):
         """call(gmpu_mesh*) on this mesh's library copy (made for the call when built from arrays)."""
@@ -187,7 +227,9 @@ class Mesh:
             return call(self._handle)
         out = ffi.new("gmpu_mesh **")
         v, f = self._vertices, self._faces
-        check(lib.gmpu_mesh_create(double_ptr(v), len(v), uint32_ptr(f), len(f), out), "gmpu_mesh_create")
+        check(lib.gmpu_mesh_create_with(double_ptr(v), len(v), uint32_ptr(f), len(f), double_ptr(self._normals),
+                                        double_ptr(self._confidence), uint8_ptr(self._colors), out),
+              "gmpu_mesh_create_with")
         mesh = ffi.gc(out[0], lib.gmpu_mesh_destroy)
         try:
             return call(mesh)
@@ -227,8 +269,10 @@ class Mesh:
     def __reduce__(self):
         # Pickled as its arrays (copies: a library mesh's are views of C memory), so a mesh
         # can come back from multiprocessing; it unpickles as a mesh built from arrays.
-        normals = None if self._normals is None else np.array(self._normals)
-        return (Mesh, (np.array(self._vertices), np.array(self._faces), normals))
+        def copy(a):
+            return None if a is None else np.array(a)
+        return (Mesh, (np.array(self._vertices), np.array(self._faces), copy(self._normals), copy(self._confidence),
+                       copy(self._colors)))
 
     @property
     def is_watertight(self) -> bool:
@@ -265,30 +309,23 @@ class Mesh:
                                       o3d.utility.Vector3iVector(self._faces.astype(np.int32)))
         if self._normals is not None:
             m.vertex_normals = o3d.utility.Vector3dVector(np.array(self._normals))
+        if self._colors is not None:
+            m.vertex_colors = o3d.utility.Vector3dVector(self._colors / 255.0)
         return m
 
     def write(self, path: PathLike) -> None:
-        """Writes the mesh; the format comes from the extension: .ply (binary), .obj, .off.
+        """Writes the mesh; the format comes from the extension: .ply (binary), .obj, .off,
+        .stl, .glb.
 
         Atomic: a failure never leaves a partial file. A mesh made by polygonize is written
-        straight from the library's copy, vertex normals included (byte for byte what
-        gmpu-reconstruct writes); a mesh built from arrays goes through gmpu_mesh_create,
-        which has no normals argument, so its normals are not written.
+        straight from the library's copy (byte for byte what gmpu-reconstruct writes); a mesh
+        built from arrays goes through gmpu_mesh_create_with: its normals, confidence and
+        colors are written too.
         Raises gmpu.UnsupportedError (extension), gmpu.IoError, gmpu.InvalidInputError
         (a non-finite vertex).
         """
         p = _fspath(path)
-        if self._handle is not None:
-            check(lib.gmpu_mesh_write(self._handle, p), "gmpu_mesh_write", os.fspath(path))
-            return
-        out = ffi.new("gmpu_mesh **")
-        v, f = self._vertices, self._faces
-        check(lib.gmpu_mesh_create(double_ptr(v), len(v), uint32_ptr(f), len(f), out), "gmpu_mesh_create")
-        mesh = ffi.gc(out[0], lib.gmpu_mesh_destroy)
-        try:
-            check(lib.gmpu_mesh_write(mesh, p), "gmpu_mesh_write", os.fspath(path))
-        finally:
-            ffi.release(mesh)  # frees now, not at the next garbage collection
+        self._with_c_mesh(lambda mesh: check(lib.gmpu_mesh_write(mesh, p), "gmpu_mesh_write", os.fspath(path)))
 
 
 class Points:
@@ -299,7 +336,7 @@ class Points:
     ``normals=points.normals`` to use them.
     """
 
-    def __init__(self, positions: ArrayLike, normals: Optional[ArrayLike] = None):
+    def __init__(self, positions: ArrayLike, normals: Optional[ArrayLike] = None, colors: Optional[ArrayLike] = None):
         p = np.ascontiguousarray(_as_real_array(positions, "positions"), dtype=np.float64)
         if p.ndim != 2 or p.shape[1] != 3:
             raise ValueError(f"positions: expected an n×3 array, got shape {p.shape}")
@@ -309,6 +346,7 @@ class Points:
             if n.shape != p.shape:
                 raise ValueError(f"normals: expected shape {p.shape}, got {n.shape}")
         self._positions, self._normals, self._handle = p, n, None
+        self._colors = _colours(colors, len(p))
 
     @classmethod
     def _from_c(cls, ptr) -> "Points":
@@ -319,6 +357,8 @@ class Points:
         self._positions = view_of_c_memory(handle, lib.gmpu_points_positions(handle), (count, 3), np.float64)
         normals = lib.gmpu_points_normals(handle)
         self._normals = None if normals == ffi.NULL else view_of_c_memory(handle, normals, (count, 3), np.float64)
+        colors = lib.gmpu_points_colors(handle)
+        self._colors = None if colors == ffi.NULL else view_of_c_memory(handle, colors, (count, 3), np.uint8)
         return self
 
     @property
@@ -330,6 +370,24 @@ class Points:
     def normals(self) -> Optional[NDArray[np.float64]]:
         """n×3 float64 normals, or None when the file had none."""
         return self._normals
+
+    @property
+    def colors(self) -> Optional[NDArray[np.uint8]]:
+        """n×3 uint8 red green blue, or None (only .ply files with uchar red green blue have them)."""
+        return self._colors
+
+    def _with_c_points(self, call):
+        """call(gmpu_points*) on this cloud's library copy (made for the call when built from arrays)."""
+        if self._handle is not None:
+            return call(self._handle)
+        out = ffi.new("gmpu_points **")
+        check(lib.gmpu_points_create_with(double_ptr(self._positions), double_ptr(self._normals),
+                                          uint8_ptr(self._colors), len(self), out), "gmpu_points_create_with")
+        pts = ffi.gc(out[0], lib.gmpu_points_destroy)
+        try:
+            return call(pts)
+        finally:
+            ffi.release(pts)
 
     def __len__(self) -> int:
         return len(self._positions)
@@ -356,13 +414,21 @@ class Points:
             ffi.release(pts)
 
 
-def read_points(path: PathLike) -> Points:
-    """Reads a point cloud: .ply (ascii or binary; x y z and optional nx ny nz), .xyz / .txt
-    (3 or 6 columns), .off / .obj (vertices only). The arrays are views of the library's
-    copy (no second copy). Raises gmpu.IoError, gmpu.ParseError, gmpu.UnsupportedError,
-    gmpu.InvalidInputError (no points)."""
+def read_points(path: PathLike, *, max_memory: float = 0, progress: Optional[ProgressFn] = None) -> Points:
+    """Reads a point cloud: .ply (ascii or binary; x y z, optional nx ny nz, optional uchar
+    red green blue), .xyz / .txt (3 or 6 columns), .off / .obj (vertices only). The arrays
+    are views of the library's copy (no second copy).
+
+    max_memory: budget in bytes (0: half the physical memory); a file whose points would need
+    more raises gmpu.LimitExceededError before its body is read. progress: f(Stage.READ,
+    fraction), with the stages' contract (False or an exception cancels).
+    Raises gmpu.IoError, gmpu.ParseError, gmpu.UnsupportedError, gmpu.InvalidInputError
+    (no points), gmpu.LimitExceededError, gmpu.CancelledError."""
     out = ffi.new("gmpu_points **")
-    check(lib.gmpu_points_read(_fspath(path), out), "gmpu_points_read", os.fspath(path))
+    p = _fspath(path)
+    status = run_read_with_progress(lambda fn: lib.gmpu_points_read_with(p, float(max_memory), fn, ffi.NULL, out),
+                                    progress)
+    check(status, "gmpu_points_read_with", os.fspath(path))
     return Points._from_c(out[0])
 
 
@@ -668,9 +734,16 @@ def reconstruct(points: Union[ArrayLike, Points, PathLike], *, normals: Optional
     automatic). level: level-of-detail cap (0/None: all). threads: worker threads
     (0/None: all cores). Other gmpu parameters by name (see gmpu.PARAMS).
     progress: f(stage, fraction); raising in it (or Ctrl-C) cancels and propagates.
+    Coloured points (a .ply with red green blue) give a coloured mesh: each vertex takes the
+    colour of its nearest point, as gmpu-reconstruct does.
     """
+    if isinstance(points, (str, os.PathLike)):
+        points = read_points(points)
     with Surface(points, normals=normals, progress=progress, error=error, max_depth=max_depth,
                  threads=threads, resolution=resolution, level=level, **params) as s:
         s.fit()
         s.orient()
-        return s.polygonize()
+        mesh = s.polygonize()
+    if isinstance(points, Points) and points.colors is not None:
+        return mesh.color_from(points)
+    return mesh

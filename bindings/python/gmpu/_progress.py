@@ -21,7 +21,7 @@ from typing import Callable, List, Optional
 
 from ._library import ffi, lib
 
-__all__ = ["Stage", "ProgressFn", "CallState", "run_with_progress"]
+__all__ = ["Stage", "ProgressFn", "CallState", "run_with_progress", "run_read_with_progress"]
 
 
 class Stage(enum.IntEnum):
@@ -30,6 +30,7 @@ class Stage(enum.IntEnum):
     FIT = lib.GMPU_STAGE_FIT
     ORIENT = lib.GMPU_STAGE_ORIENT
     POLYGONIZE = lib.GMPU_STAGE_POLYGONIZE
+    READ = lib.GMPU_STAGE_READ  # read_points
 
     def __str__(self) -> str:
         return self.name.lower()
@@ -97,6 +98,18 @@ def run_with_progress(surface_ptr, call: Callable[[], int], progress: Optional[P
     status = lib.gmpu_surface_set_progress(surface_ptr, fn, ffi.NULL)
     if status != 0:  # pragma: no cover - only fails for a NULL surface
         return status
+    return _routed(call, progress)
+
+
+def run_read_with_progress(call: Callable[[object], int], progress: Optional[ProgressFn]) -> int:
+    """run_with_progress for gmpu_points_read_with, which takes the callback as an argument:
+    call(fn) gets the C callback (NULL when nothing listens) and returns the status."""
+    main = threading.current_thread() is threading.main_thread()
+    fn = _C_PROGRESS if (progress is not None or main) else ffi.NULL
+    return _routed(lambda: call(fn), progress)
+
+
+def _routed(call: Callable[[], int], progress: Optional[ProgressFn]) -> int:
     state = CallState(progress)
     stack = _stack()
     stack.append(state)

@@ -154,7 +154,7 @@ def _params(func) -> list:
 def generate_summary(cdef: str) -> str:
     """The ABI summary (see the module's doc) of a cdef."""
     from pycparser import CParser, c_ast
-    prelude = "typedef unsigned long size_t; typedef unsigned int uint32_t;\n"
+    prelude = "typedef unsigned long size_t; typedef unsigned int uint32_t; typedef unsigned char uint8_t;\n"
     lines, body = [], []
     for line in cdef.splitlines():
         m = re.match(r"#define (\w+) (\d+)$", line)
@@ -163,7 +163,7 @@ def generate_summary(cdef: str) -> str:
         else:
             body.append(line)
     ast = CParser().parse(prelude + "\n".join(body), "gmpu.h")
-    for node in ast.ext[2:]:
+    for node in ast.ext[prelude.count("typedef"):]:
         t = node.type
         if isinstance(node, c_ast.Typedef) and isinstance(t, c_ast.TypeDecl) and isinstance(t.type, c_ast.Enum):
             value = 0

@@ -65,6 +65,9 @@
 #![warn(missing_docs)]
 
 pub mod sys;
+mod params;
+
+pub use params::Params;
 
 use std::any::Any;
 use std::ffi::{CStr, CString};
@@ -437,7 +440,7 @@ pub enum Stage {
     Orient,
     /// [`Surface::polygonize`].
     Polygonize,
-    /// `gmpu_points_read_with` (not wrapped by this binding yet).
+    /// [`Points::read_with`].
     Read,
     /// A stage this binding does not know (from a newer library).
     Unknown(u32),
@@ -906,6 +909,61 @@ impl Mesh {
         unsafe { Mesh::from_raw(raw) }
     }
 
+    /// A mesh from vertices and triangles with optional per-vertex normals (any non-zero
+    /// length; kept as unit vectors), confidence and colours (red green blue), all copied and
+    /// all kept by [`write`](Self::write) and [`simplify`](Self::simplify). Fails with
+    /// [`Status::InvalidInput`] for an index out of range, a non-finite coordinate, a zero or
+    /// non-finite normal, a negative or NaN confidence, or an array whose length is not the
+    /// vertex count.
+    pub fn with_attributes(
+        vertices: &[[f64; 3]],
+        triangles: &[[u32; 3]],
+        normals: Option<&[[f64; 3]]>,
+        confidence: Option<&[f64]>,
+        colors: Option<&[[u8; 3]]>,
+    ) -> Result<Mesh> {
+        let n = vertices.len();
+        let lengths = [("normals", normals.map(<[_]>::len)), ("confidence", confidence.map(<[_]>::len)), ("colors", colors.map(<[_]>::len))];
+        if let Some((what, Some(len))) = lengths.into_iter().find(|(_, len)| len.is_some_and(|len| len != n)) {
+            return Err(Error::binding(Status::InvalidInput, format_args!("{len} {what} given for {n} vertices")));
+        }
+        let mut raw = ptr::null_mut();
+        // SAFETY: arrays of the given counts (checked above), or NULL.
+        check(unsafe {
+            sys::gmpu_mesh_create_with(
+                flat(vertices),
+                n,
+                flat(triangles),
+                triangles.len(),
+                normals.map_or(ptr::null(), flat),
+                confidence.map_or(ptr::null(), <[f64]>::as_ptr),
+                colors.map_or(ptr::null(), flat),
+                &mut raw,
+            )
+        })?;
+        // SAFETY: a new mesh we own.
+        unsafe { Mesh::from_raw(raw) }
+    }
+
+    /// Red green blue per vertex; `None` unless the mesh was coloured
+    /// ([`color_from`](Self::color_from)) or built with colours.
+    pub fn colors(&self) -> Option<&[[u8; 3]]> {
+        // SAFETY: NULL or 3 × vertex_count bytes owned by the mesh.
+        let p = unsafe { sys::gmpu_mesh_colors(self.raw.as_ptr()) };
+        (!p.is_null()).then(|| unsafe { triples(p, self.vertex_count()) })
+    }
+
+    /// A copy whose every vertex takes the colour of the nearest of `points` (read from a
+    /// `.ply` with red green blue, or [`Points::with_colors`]). Fails with
+    /// [`Status::InvalidArgument`] when the points have no colours.
+    pub fn color_from(&self, points: &Points) -> Result<Mesh> {
+        let mut raw = ptr::null_mut();
+        // SAFETY: valid handles and out pointer.
+        check(unsafe { sys::gmpu_mesh_color_from_points(self.raw.as_ptr(), points.as_ptr(), &mut raw) })?;
+        // SAFETY: a new mesh we own.
+        unsafe { Mesh::from_raw(raw) }
+    }
+
     /// The raw handle, for calling [`sys`] functions. Do not destroy it.
     pub fn as_ptr(&self) -> *const sys::gmpu_mesh {
         self.raw.as_ptr()
@@ -977,7 +1035,7 @@ impl Mesh {
     }
 
     /// Writes the mesh; the format comes from the extension (`.ply` binary little-endian,
-    /// `.obj`, `.off`). Atomic: a failure never leaves a partial file.
+    /// `.obj`, `.off`, `.stl`, `.glb`). Atomic: a failure never leaves a partial file.
     pub fn write(&self, path: impl AsRef<Path>) -> Result<()> {
         let path = c_path(path.as_ref())?;
         // SAFETY: valid handle and NUL-terminated path.
@@ -1023,18 +1081,69 @@ impl Points {
             .ok_or_else(|| Error::binding(Status::Internal, "gmpu_points_read returned GMPU_OK and NULL"))
     }
 
+    /// [`read`](Self::read) with a memory budget and progress (`gmpu_points_read_with`):
+    /// `max_memory` in bytes (0: half the physical memory) — a file whose points would need
+    /// more fails with [`Status::LimitExceeded`] before its body is read; `progress` gets
+    /// [`Stage::Read`] and the fraction read, with the contract of
+    /// [`Surface::set_progress`] ([`ControlFlow::Break`] cancels: [`Status::Cancelled`]; a
+    /// panic cancels and is resumed).
+    pub fn read_with<F>(path: impl AsRef<Path>, max_memory: f64, progress: F) -> Result<Points>
+    where
+        F: FnMut(Stage, f64) -> ControlFlow<()> + Send + 'static,
+    {
+        let path = c_path(path.as_ref())?;
+        let mut state = ProgressState { callback: Box::new(progress), panic: None };
+        let mut raw = ptr::null_mut();
+        // SAFETY: NUL-terminated path, valid out pointer; state outlives the call, which is
+        // the only user of the trampoline's pointer.
+        let status = unsafe {
+            sys::gmpu_points_read_with(
+                path.as_ptr(),
+                max_memory,
+                Some(progress_trampoline),
+                ptr::addr_of_mut!(state).cast(),
+                &mut raw,
+            )
+        };
+        if let Some(payload) = state.panic.take() {
+            panic::resume_unwind(payload);
+        }
+        check(status)?;
+        NonNull::new(raw)
+            .map(|raw| Points { raw })
+            .ok_or_else(|| Error::binding(Status::Internal, "gmpu_points_read_with returned GMPU_OK and NULL"))
+    }
+
     /// A point set from positions and optional normals (copied; same length).
     pub fn new(positions: &[[f64; 3]], normals: Option<&[[f64; 3]]>) -> Result<Points> {
+        Points::with_colors(positions, normals, None)
+    }
+
+    /// A point set from positions, optional normals and optional colours (red green blue),
+    /// copied; every array as long as `positions`.
+    pub fn with_colors(positions: &[[f64; 3]], normals: Option<&[[f64; 3]]>, colors: Option<&[[u8; 3]]>) -> Result<Points> {
         if let Some(n) = normals.filter(|n| n.len() != positions.len()) {
             return Err(Error::binding(
                 Status::InvalidInput,
                 format_args!("{} normals given for {} points", n.len(), positions.len()),
             ));
         }
+        if let Some(c) = colors.filter(|c| c.len() != positions.len()) {
+            return Err(Error::binding(
+                Status::InvalidInput,
+                format_args!("{} colors given for {} points", c.len(), positions.len()),
+            ));
+        }
         let mut raw = ptr::null_mut();
-        // SAFETY: positions.len() triples each, normals NULL or as many.
+        // SAFETY: positions.len() triples each, normals and colors NULL or as many.
         check(unsafe {
-            sys::gmpu_points_create(flat(positions), normals.map_or(ptr::null(), flat), positions.len(), &mut raw)
+            sys::gmpu_points_create_with(
+                flat(positions),
+                normals.map_or(ptr::null(), flat),
+                colors.map_or(ptr::null(), flat),
+                positions.len(),
+                &mut raw,
+            )
         })?;
         NonNull::new(raw)
             .map(|raw| Points { raw })
@@ -1067,6 +1176,14 @@ impl Points {
     pub fn normals(&self) -> Option<&[[f64; 3]]> {
         // SAFETY: NULL or 3 × count doubles owned by the point set.
         let p = unsafe { sys::gmpu_points_normals(self.raw.as_ptr()) };
+        (!p.is_null()).then(|| unsafe { triples(p, self.len()) })
+    }
+
+    /// Red green blue per point, from a `.ply` with uchar red green blue (or
+    /// [`with_colors`](Self::with_colors)).
+    pub fn colors(&self) -> Option<&[[u8; 3]]> {
+        // SAFETY: NULL or 3 × count bytes owned by the point set.
+        let p = unsafe { sys::gmpu_points_colors(self.raw.as_ptr()) };
         (!p.is_null()).then(|| unsafe { triples(p, self.len()) })
     }
 

@@ -73,9 +73,9 @@ macro_rules! c_functions {
 
 /// `#define`d integer constants of the header.
 pub const GMPU_VERSION_MAJOR: u32 = 0;
-pub const GMPU_VERSION_MINOR: u32 = 3;
+pub const GMPU_VERSION_MINOR: u32 = 4;
 pub const GMPU_VERSION_PATCH: u32 = 0;
-pub const GMPU_VERSION_NUMBER: u32 = 300;
+pub const GMPU_VERSION_NUMBER: u32 = 400;
 pub const GMPU_ABI_VERSION: u32 = 1;
 pub const DEFINES: &[(&str, u32)] = &[
     ("GMPU_VERSION_MAJOR", GMPU_VERSION_MAJOR),
@@ -203,6 +203,8 @@ c_functions! {
     pub fn gmpu_param_count() -> c_int;
     pub fn gmpu_param_info(key: gmpu_param, info: *mut gmpu_param_info_t) -> gmpu_status;
     pub fn gmpu_param_key(name: *const c_char) -> c_int;
+    pub fn gmpu_stat_count() -> c_int;
+    pub fn gmpu_stat_name(key: gmpu_stat) -> *const c_char;
 
     pub fn gmpu_surface_create(out: *mut *mut gmpu_surface) -> gmpu_status;
     pub fn gmpu_surface_destroy(surface: *mut gmpu_surface);
@@ -232,6 +234,9 @@ c_functions! {
 
     pub fn gmpu_mesh_create(vertices: *const f64, vertex_count: usize, triangles: *const u32,
         triangle_count: usize, out: *mut *mut gmpu_mesh) -> gmpu_status;
+    pub fn gmpu_mesh_create_with(vertices: *const f64, vertex_count: usize, triangles: *const u32,
+        triangle_count: usize, normals: *const f64, confidence: *const f64, colors: *const u8,
+        out: *mut *mut gmpu_mesh) -> gmpu_status;
     pub fn gmpu_mesh_destroy(mesh: *mut gmpu_mesh);
     pub fn gmpu_mesh_vertex_count(mesh: *const gmpu_mesh) -> usize;
     pub fn gmpu_mesh_triangle_count(mesh: *const gmpu_mesh) -> usize;
@@ -240,6 +245,9 @@ c_functions! {
     pub fn gmpu_mesh_triangles(mesh: *const gmpu_mesh) -> *const u32;
     pub fn gmpu_mesh_write(mesh: *const gmpu_mesh, path: *const c_char) -> gmpu_status;
     pub fn gmpu_mesh_confidence(mesh: *const gmpu_mesh) -> *const f64;
+    pub fn gmpu_mesh_colors(mesh: *const gmpu_mesh) -> *const u8;
+    pub fn gmpu_mesh_color_from_points(mesh: *const gmpu_mesh, points: *const gmpu_points,
+        out: *mut *mut gmpu_mesh) -> gmpu_status;
     pub fn gmpu_mesh_simplify(mesh: *const gmpu_mesh, target_triangles: usize, target_error: f64,
                               out: *mut *mut gmpu_mesh) -> gmpu_status;
     pub fn gmpu_mesh_trim(mesh: *const gmpu_mesh, threshold: f64, out: *mut *mut gmpu_mesh) -> gmpu_status;
@@ -254,9 +262,12 @@ c_functions! {
     ) -> gmpu_status;
     pub fn gmpu_points_create(xyz: *const f64, normals: *const f64, count: usize, out: *mut *mut gmpu_points)
         -> gmpu_status;
+    pub fn gmpu_points_create_with(xyz: *const f64, normals: *const f64, colors: *const u8, count: usize,
+        out: *mut *mut gmpu_points) -> gmpu_status;
     pub fn gmpu_points_destroy(points: *mut gmpu_points);
     pub fn gmpu_points_count(points: *const gmpu_points) -> usize;
     pub fn gmpu_points_positions(points: *const gmpu_points) -> *const f64;
     pub fn gmpu_points_normals(points: *const gmpu_points) -> *const f64;
+    pub fn gmpu_points_colors(points: *const gmpu_points) -> *const u8;
     pub fn gmpu_points_write(points: *const gmpu_points, path: *const c_char) -> gmpu_status;
 }

@@ -51,3 +51,53 @@ fn simplify_and_trim_refuse_bad_arguments() {
     // A closed sphere is fully supported: trimming keeps it whole.
     assert_eq!(mesh.trim(3.0).unwrap().triangle_count(), mesh.triangle_count());
 }
+
+#[test]
+fn a_mesh_from_arrays_keeps_normals_confidence_and_colours_when_written() {
+    let made = polygonized(&sphere(1500, [0.0; 3], 1.0));
+    let colours: Vec<[u8; 3]> = made.vertices().iter().map(|v| if v[0] > 0.0 { [255, 0, 0] } else { [0, 0, 255] }).collect();
+    let copy =
+        Mesh::with_attributes(made.vertices(), made.triangles(), made.normals(), made.confidence(), Some(&colours)).unwrap();
+    assert_eq!(copy.normals(), made.normals());
+    assert_eq!(copy.colors(), Some(&colours[..]));
+    let path = temp_path("mesh_attributes", "copy.ply");
+    copy.write(&path).unwrap();
+    let back = gmpu::Points::read(&path).unwrap();
+    assert_eq!(back.normals(), made.normals());
+    assert_eq!(back.colors(), Some(&colours[..]));
+    // The colours of a mesh from the nearest coloured point.
+    let plain = Mesh::new(made.vertices(), made.triangles()).unwrap();
+    assert_eq!(plain.colors(), None);
+    assert_eq!(plain.color_from(&back).unwrap().colors(), Some(&colours[..]));
+    assert_eq!(plain.color_from(&gmpu::Points::new(made.vertices(), None).unwrap()).unwrap_err().status(), Status::InvalidArgument);
+    let e = Mesh::with_attributes(made.vertices(), made.triangles(), None, Some(&[1.0]), None).unwrap_err();
+    assert_eq!(e.status(), Status::InvalidInput);
+    assert!(e.message().contains("1 confidence given"), "{}", e.message());
+    remove_temp_dir("mesh_attributes");
+}
+
+#[test]
+fn points_read_with_reports_progress_cancels_and_keeps_the_budget() {
+    use gmpu::{ControlFlow, Points, Stage};
+    use std::sync::{Arc, Mutex};
+    let path = temp_path("points_read_with", "big.xyz");
+    let text: String = sphere(30000, [0.0; 3], 1.0).iter().map(|p| format!("{} {} {}\n", p[0], p[1], p[2])).collect();
+    std::fs::write(&path, text).unwrap();
+    let seen = Arc::new(Mutex::new(Vec::new()));
+    let log = Arc::clone(&seen);
+    let points = Points::read_with(&path, 0.0, move |stage, f| {
+        log.lock().unwrap().push((stage, f));
+        ControlFlow::Continue(())
+    })
+    .unwrap();
+    assert_eq!(points.len(), 30000);
+    let seen = seen.lock().unwrap();
+    assert!(seen.iter().all(|(stage, _)| *stage == Stage::Read) && seen.last().unwrap().1 == 1.0);
+    let e = Points::read_with(&path, 0.0, |_, _| ControlFlow::Break(())).unwrap_err();
+    assert_eq!(e.status(), Status::Cancelled);
+    let e = Points::read_with(&path, 1e6, |_, _| ControlFlow::Continue(())).unwrap_err();
+    assert_eq!(e.status(), Status::LimitExceeded);
+    let caught = std::panic::catch_unwind(|| Points::read_with(&path, 0.0, |_, _| panic!("from the callback")));
+    assert!(caught.is_err());
+    remove_temp_dir("points_read_with");
+}
