@@ -16,6 +16,8 @@
 #include "core/progress.hpp"
 #include "fit/build_octree.hpp"
 #include "geometry/point_set.hpp"
+#include "implicit/mpu_function.hpp"
+#include "implicit/on_sheet_normal.hpp"
 #include "orient/advancing_front.hpp"
 #include "orient/leaf_graph.hpp"
 #include "orient/orient.hpp"
@@ -108,6 +110,52 @@ Octree two_level_octree(int flipped) {
     children(0);
     children(8);  // octant 7 of the root
     return t;
+}
+
+// A thin slab, top sheet z = −0.28 (outward +z), bottom sheet z = −0.32 (outward −z). The
+// root's four upper children fit the top sheet, the four lower ones the bottom sheet, all
+// oriented consistently (positive inside the slab). At a point of the top sheet the lower
+// leaves, whose centres are much nearer, dominate the blend, and −∇f points down: the
+// normal of the other sheet. Only the leaves whose sheet passes by the point may speak.
+void point_normal_comes_from_the_sheet_through_the_point(void **) {
+    const double top = -0.28, bottom = -0.32;
+    Octree t;
+    Cell root;
+    root.size = kRootSize;
+    root.radius = root.subtree_radius = 2.0;
+    root.first_child = 1;
+    root.child_mask = 0xff;
+    t.cells.push_back(root);
+    for (int o = 0; o < 8; ++o) {
+        Cell c;
+        c.size = 0.5 * kRootSize;
+        c.depth = 1;
+        c.parent = 0;
+        for (int d = 0; d < 3; ++d) {
+            c.coord[d] = uint16_t(o >> d & 1);
+            c.centre[d] = (o >> d & 1 ? 0.25 : -0.25) * kRootSize;
+        }
+        c.radius = c.subtree_radius = 0.75 * std::sqrt(3.0) * c.size;
+        c.support_count = 10000;  // dense: a sheet 0.04 away is many spacings off
+        c.shape.model = Model::bivariate;
+        const bool upper = o & 4;
+        c.shape.q = upper ? Quadric::affine({0, 0, -1}, top - c.centre[2])       // top − z
+                          : Quadric::affine({0, 0, 1}, c.centre[2] - bottom);    // z − bottom
+        t.cells.push_back(c);
+    }
+    const CellSigns as_fitted;
+    const MpuFunction f(t, as_fitted, 0);
+    std::vector<uint32_t> near;
+    for (const double z : {top, bottom}) {
+        const Vector3d p(0.1, -0.05, z);
+        f.gather(Eigen::AlignedBox3d(p - Vector3d::Constant(0.01), p + Vector3d::Constant(0.01)), near);
+        const double outward = z == top ? 1.0 : -1.0;
+        Vector3d g;
+        f.value_among(near, p, &g);
+        if (z == top) assert_true(-g.normalized().z() * outward < 0.0);  // the blend is wrong here...
+        assert_true(on_sheet_gradient(f, near, p, g));
+        assert_true(-g.normalized().z() * outward > 0.99);  // ...the sheet through p is right
+    }
 }
 
 void leaf_graph_of_a_known_octree(void **) {
@@ -359,6 +407,7 @@ int main() {
         cmocka_unit_test(front_recovers_a_consistent_orientation),
         cmocka_unit_test(bp_is_right_where_the_vote_is_wrong),
         cmocka_unit_test(outward_pass_orients_nested_shells),
+        cmocka_unit_test(point_normal_comes_from_the_sheet_through_the_point),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
