@@ -18,6 +18,7 @@
 #include "geometry/point_set.hpp"
 #include "implicit/mpu_function.hpp"
 #include "implicit/on_sheet_normal.hpp"
+#include "implicit/point_measures.hpp"
 #include "orient/advancing_front.hpp"
 #include "orient/leaf_graph.hpp"
 #include "orient/orient.hpp"
@@ -117,8 +118,9 @@ Octree two_level_octree(int flipped) {
 // oriented consistently (positive inside the slab). At a point of the top sheet the lower
 // leaves, whose centres are much nearer, dominate the blend, and −∇f points down: the
 // normal of the other sheet. Only the leaves whose sheet passes by the point may speak.
-void point_normal_comes_from_the_sheet_through_the_point(void **) {
-    const double top = -0.28, bottom = -0.32;
+// The slab's octree of point_normal_comes_from_the_sheet_through_the_point; `order` and the
+// leaves' point ranges are filled for `points` (already in the normalised frame).
+Octree slab_octree(double top, double bottom, const PointSet *points) {
     Octree t;
     Cell root;
     root.size = kRootSize;
@@ -141,8 +143,21 @@ void point_normal_comes_from_the_sheet_through_the_point(void **) {
         const bool upper = o & 4;
         c.shape.q = upper ? Quadric::affine({0, 0, -1}, top - c.centre[2])       // top − z
                           : Quadric::affine({0, 0, 1}, c.centre[2] - bottom);    // z − bottom
+        c.point_begin = uint32_t(t.order.size());
+        for (uint32_t i = 0; points && i < points->size(); ++i) {
+            const Vector3d q = points->point(i);
+            if ((q.x() > 0) == bool(o & 1) && (q.y() > 0) == bool(o & 2) && (q.z() > 0) == bool(o & 4))
+                t.order.push_back(i);
+        }
+        c.point_end = uint32_t(t.order.size());
         t.cells.push_back(c);
     }
+    return t;
+}
+
+void point_normal_comes_from_the_sheet_through_the_point(void **) {
+    const double top = -0.28, bottom = -0.32;
+    const Octree t = slab_octree(top, bottom, nullptr);
     const CellSigns as_fitted;
     const MpuFunction f(t, as_fitted, 0);
     std::vector<uint32_t> near;
@@ -155,6 +170,34 @@ void point_normal_comes_from_the_sheet_through_the_point(void **) {
         if (z == top) assert_true(-g.normalized().z() * outward < 0.0);  // the blend is wrong here...
         assert_true(on_sheet_gradient(f, near, p, g));
         assert_true(-g.normalized().z() * outward > 0.99);  // ...the sheet through p is right
+    }
+}
+
+// The same slab through point_normals: with from_sheets every point of both sheets gets its
+// sheet's outward normal; the blend alone turns some of the top sheet's over.
+void point_normals_from_sheets_on_a_thin_slab(void **) {
+    const double top = -0.28, bottom = -0.32;
+    std::vector<double> xyz;
+    for (double z : {top, bottom})
+        for (int i = 0; i < 6; ++i)
+            for (int j = 0; j < 6; ++j) xyz.insert(xyz.end(), {-0.5 + 0.2 * i, -0.5 + 0.2 * j, z});
+    xyz.insert(xyz.end(), {0.5, 0.5, 0.32});  // keeps the slab low in the normalised box
+    const size_t n = xyz.size() / 3;
+    const PointSet ps = PointSet::from_array(xyz.data(), n, 0, 1);
+    const Octree t = slab_octree(ps.point(0).z(), ps.point(36).z(), &ps);  // the sheets, normalised
+    assert_int_equal(t.order.size(), n);
+    const CellSigns as_fitted;
+    const MpuFunction f(t, as_fitted, 0);
+    Workers workers(2);
+    Progress quiet(nullptr, nullptr, GMPU_STAGE_ORIENT);
+    for (const bool from_sheets : {false, true}) {
+        std::vector<float> blend;
+        const std::vector<float> normals = point_normals(f, ps, workers, quiet, from_sheets, &blend);
+        size_t right = 0;
+        for (size_t i = 0; i + 1 < n; ++i) right += normals[3 * i + 2] * (i < 36 ? 1 : -1) > 0.9;  // top first
+        if (from_sheets) assert_int_equal(right, n - 1);
+        else assert_true(right < n - 1);
+        for (size_t i = 0; !from_sheets && i < 3 * n; ++i) assert_true(blend[i] == normals[i]);
     }
 }
 
@@ -408,6 +451,7 @@ int main() {
         cmocka_unit_test(bp_is_right_where_the_vote_is_wrong),
         cmocka_unit_test(outward_pass_orients_nested_shells),
         cmocka_unit_test(point_normal_comes_from_the_sheet_through_the_point),
+        cmocka_unit_test(point_normals_from_sheets_on_a_thin_slab),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
