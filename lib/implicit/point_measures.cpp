@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "core/resize_reporting.hpp"
+#include "implicit/on_sheet_normal.hpp"
 
 namespace gmpu {
 
@@ -54,10 +55,11 @@ void measure_areas(const Octree &tree, const PointSet &points, Workers &workers,
 }  // namespace
 
 std::vector<float> point_normals(const MpuFunction &mpu, const PointSet &points, Workers &workers,
-                                 Progress &progress) {
+                                 Progress &progress, bool from_sheets, std::vector<float> *blend_normals) {
     const Octree &tree = mpu.tree();
     std::vector<float> out;
     assign_reporting(out, 3 * points.size(), progress);
+    if (blend_normals) assign_reporting(*blend_normals, 3 * points.size(), progress);
     std::vector<uint32_t> leaves;
     for (uint32_t i = 0; i < tree.cells.size(); ++i)
         if (tree.cells[i].is_leaf() && tree.cells[i].point_end > tree.cells[i].point_begin) leaves.push_back(i);
@@ -81,6 +83,10 @@ std::vector<float> point_normals(const MpuFunction &mpu, const PointSet &points,
                 gn = g.norm();
             }
             Eigen::Vector3d n = gn > 0.0 ? Eigen::Vector3d(-g / gn) : Eigen::Vector3d::UnitZ();
+            if (blend_normals)
+                for (int d = 0; d < 3; ++d) (*blend_normals)[3 * i + d] = float(n[d]);
+            Eigen::Vector3d s;
+            if (from_sheets && on_sheet_gradient(mpu, near, p, s)) n = -s.normalized();
             for (int d = 0; d < 3; ++d) out[3 * i + d] = float(n[d]);
         }
     }, 1);  // leaves come coarsest first: one per chunk
@@ -89,9 +95,10 @@ std::vector<float> point_normals(const MpuFunction &mpu, const PointSet &points,
 }
 
 
-PointMeasures measure_points(const MpuFunction &mpu, const PointSet &points, Workers &workers, Progress &progress) {
+PointMeasures measure_points(const MpuFunction &mpu, const PointSet &points, Workers &workers, Progress &progress,
+                             bool noisy_fits) {
     PointMeasures out;
-    out.normals = point_normals(mpu, points, workers, progress);
+    out.normals = point_normals(mpu, points, workers, progress, noisy_fits, &out.blend_normals);
     // Areas and trust radii take no share of the bar: they cost little next to the normals.
     Progress areas_progress = progress.slice(1.0, 1.0);
     measure_areas(mpu.tree(), points, workers, areas_progress, out);

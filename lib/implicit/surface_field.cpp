@@ -54,7 +54,7 @@ double SurfaceField::far_value(const Eigen::Vector3d &x, Eigen::Vector3d *gradie
         double vote = 0.0;
         for (size_t k = 0; k < idx.size(); ++k) {
             const uint32_t i = idx[k];
-            Eigen::Vector3d n(measures_.normals[3 * i], measures_.normals[3 * i + 1], measures_.normals[3 * i + 2]);
+            Eigen::Vector3d n(measures_.blend_normals[3 * i], measures_.blend_normals[3 * i + 1], measures_.blend_normals[3 * i + 2]);
             double side = (x - points_.point(i)).dot(n);
             vote += (side < 0.0 ? 1.0 : -1.0) / (std::sqrt(double(d2[k])) + 1e-12);
         }

@@ -10,8 +10,9 @@ namespace {
 
 // Resident from the fit, per point: the normalised floats, the kd-trees and the octree's order.
 constexpr double kResidentBytesPerPoint = 48;
-// Orient's own, per point: normal, area and trust radius, and the searches that make them.
-constexpr double kOrientBytesPerPoint = 32;
+// Orient's own, per point: the output and the blend's normals, area and trust radius, and
+// the searches that make them.
+constexpr double kOrientBytesPerPoint = 44;
 // Per leaf: its graph node and about thirty directed edges (neighbour and agreement), its
 // component, label and place in the front's queue and heap, and its outward moment.
 constexpr double kOrientBytesPerLeaf = 30 * 5 + 64 + 64;

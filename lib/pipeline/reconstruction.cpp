@@ -69,8 +69,9 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
     Orientation orientation = orient_octree(tree, points, input_normals.empty() ? nullptr : input_normals.data(),
                                             pool, signs_progress);
     const MpuFunction mpu(tree, orientation.signs, 0);
-    measures = measure_points(mpu, points, pool, measures_progress);
-    winding = WindingField(tree, points, measures.normals, measures.area, &winding_progress);
+    // Noise-limited fits: the noise estimate is a sizeable share of the ε the tree was fitted to.
+    measures = measure_points(mpu, points, pool, measures_progress, noise >= 0.25 * epsilon);
+    winding = WindingField(tree, points, measures.blend_normals, measures.area, &winding_progress);
     std::shared_ptr<const SmoothField> new_smooth =
         wants_smooth ? solve_smooth_surface(params, tree, points, measures, noise, smooth_progress) : nullptr;
     finish(progress);

@@ -16,6 +16,9 @@
 #include "core/progress.hpp"
 #include "fit/build_octree.hpp"
 #include "geometry/point_set.hpp"
+#include "implicit/mpu_function.hpp"
+#include "implicit/on_sheet_normal.hpp"
+#include "implicit/point_measures.hpp"
 #include "orient/advancing_front.hpp"
 #include "orient/leaf_graph.hpp"
 #include "orient/orient.hpp"
@@ -108,6 +111,94 @@ Octree two_level_octree(int flipped) {
     children(0);
     children(8);  // octant 7 of the root
     return t;
+}
+
+// A thin slab, top sheet z = −0.28 (outward +z), bottom sheet z = −0.32 (outward −z). The
+// root's four upper children fit the top sheet, the four lower ones the bottom sheet, all
+// oriented consistently (positive inside the slab). At a point of the top sheet the lower
+// leaves, whose centres are much nearer, dominate the blend, and −∇f points down: the
+// normal of the other sheet. Only the leaves whose sheet passes by the point may speak.
+// The slab's octree of point_normal_comes_from_the_sheet_through_the_point; `order` and the
+// leaves' point ranges are filled for `points` (already in the normalised frame).
+Octree slab_octree(double top, double bottom, const PointSet *points) {
+    Octree t;
+    Cell root;
+    root.size = kRootSize;
+    root.radius = root.subtree_radius = 2.0;
+    root.first_child = 1;
+    root.child_mask = 0xff;
+    t.cells.push_back(root);
+    for (int o = 0; o < 8; ++o) {
+        Cell c;
+        c.size = 0.5 * kRootSize;
+        c.depth = 1;
+        c.parent = 0;
+        for (int d = 0; d < 3; ++d) {
+            c.coord[d] = uint16_t(o >> d & 1);
+            c.centre[d] = (o >> d & 1 ? 0.25 : -0.25) * kRootSize;
+        }
+        c.radius = c.subtree_radius = 0.75 * std::sqrt(3.0) * c.size;
+        c.support_count = 10000;  // dense: a sheet 0.04 away is many spacings off
+        c.shape.model = Model::bivariate;
+        const bool upper = o & 4;
+        c.shape.q = upper ? Quadric::affine({0, 0, -1}, top - c.centre[2])       // top − z
+                          : Quadric::affine({0, 0, 1}, c.centre[2] - bottom);    // z − bottom
+        c.point_begin = uint32_t(t.order.size());
+        for (uint32_t i = 0; points && i < points->size(); ++i) {
+            const Vector3d q = points->point(i);
+            if ((q.x() > 0) == bool(o & 1) && (q.y() > 0) == bool(o & 2) && (q.z() > 0) == bool(o & 4))
+                t.order.push_back(i);
+        }
+        c.point_end = uint32_t(t.order.size());
+        t.cells.push_back(c);
+    }
+    return t;
+}
+
+void point_normal_comes_from_the_sheet_through_the_point(void **) {
+    const double top = -0.28, bottom = -0.32;
+    const Octree t = slab_octree(top, bottom, nullptr);
+    const CellSigns as_fitted;
+    const MpuFunction f(t, as_fitted, 0);
+    std::vector<uint32_t> near;
+    for (const double z : {top, bottom}) {
+        const Vector3d p(0.1, -0.05, z);
+        f.gather(Eigen::AlignedBox3d(p - Vector3d::Constant(0.01), p + Vector3d::Constant(0.01)), near);
+        const double outward = z == top ? 1.0 : -1.0;
+        Vector3d g;
+        f.value_among(near, p, &g);
+        if (z == top) assert_true(-g.normalized().z() * outward < 0.0);  // the blend is wrong here...
+        assert_true(on_sheet_gradient(f, near, p, g));
+        assert_true(-g.normalized().z() * outward > 0.99);  // ...the sheet through p is right
+    }
+}
+
+// The same slab through point_normals: with from_sheets every point of both sheets gets its
+// sheet's outward normal; the blend alone turns some of the top sheet's over.
+void point_normals_from_sheets_on_a_thin_slab(void **) {
+    const double top = -0.28, bottom = -0.32;
+    std::vector<double> xyz;
+    for (double z : {top, bottom})
+        for (int i = 0; i < 6; ++i)
+            for (int j = 0; j < 6; ++j) xyz.insert(xyz.end(), {-0.5 + 0.2 * i, -0.5 + 0.2 * j, z});
+    xyz.insert(xyz.end(), {0.5, 0.5, 0.32});  // keeps the slab low in the normalised box
+    const size_t n = xyz.size() / 3;
+    const PointSet ps = PointSet::from_array(xyz.data(), n, 0, 1);
+    const Octree t = slab_octree(ps.point(0).z(), ps.point(36).z(), &ps);  // the sheets, normalised
+    assert_int_equal(t.order.size(), n);
+    const CellSigns as_fitted;
+    const MpuFunction f(t, as_fitted, 0);
+    Workers workers(2);
+    Progress quiet(nullptr, nullptr, GMPU_STAGE_ORIENT);
+    for (const bool from_sheets : {false, true}) {
+        std::vector<float> blend;
+        const std::vector<float> normals = point_normals(f, ps, workers, quiet, from_sheets, &blend);
+        size_t right = 0;
+        for (size_t i = 0; i + 1 < n; ++i) right += normals[3 * i + 2] * (i < 36 ? 1 : -1) > 0.9;  // top first
+        if (from_sheets) assert_int_equal(right, n - 1);
+        else assert_true(right < n - 1);
+        for (size_t i = 0; !from_sheets && i < 3 * n; ++i) assert_true(blend[i] == normals[i]);
+    }
 }
 
 void leaf_graph_of_a_known_octree(void **) {
@@ -359,6 +450,8 @@ int main() {
         cmocka_unit_test(front_recovers_a_consistent_orientation),
         cmocka_unit_test(bp_is_right_where_the_vote_is_wrong),
         cmocka_unit_test(outward_pass_orients_nested_shells),
+        cmocka_unit_test(point_normal_comes_from_the_sheet_through_the_point),
+        cmocka_unit_test(point_normals_from_sheets_on_a_thin_slab),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
