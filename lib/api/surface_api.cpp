@@ -360,7 +360,7 @@ GMPU_API gmpu_status gmpu_surface_polygonize(gmpu_surface *s, gmpu_mesh **out) {
             *out = mesh.release();
             return;
         }
-        int resolution = s->params.resolution > 0 ? s->params.resolution : gmpu::default_resolution(s->tree);
+        int resolution = s->params.resolution > 0 ? s->params.resolution : gmpu::default_resolution(s->tree, s->measures);
         // The steps' shares of the stage's progress.
         gmpu::Progress mesh_progress = progress.slice(0.0, 0.95), confidence_progress = progress.slice(0.95, 1.0);
         auto mesh = std::make_unique<gmpu_mesh>();

@@ -8,9 +8,11 @@
 #include "core/memory_budget.hpp"
 #include "core/parallel.hpp"
 #include "mesh/block_grid.hpp"
+#include "mesh/edge_root.hpp"
 #include "mesh/marching_tetrahedra.hpp"
 #include "mesh/mesh_cleanup.hpp"
 #include "mesh/point_buckets.hpp"
+#include "mesh/sharpen.hpp"
 #include "mesh/weld.hpp"
 
 namespace gmpu {
@@ -26,6 +28,23 @@ constexpr uint32_t kMinVotes = 15;
 constexpr double kCubesPerGap = 0.4;
 // Share of the points that two-sheet leaves must hold for their gap to set the grid.
 constexpr double kWallShare = 0.1;
+// Mesh size (default_resolution): triangles wanted per input point (under the 2 the mesh
+// may have, as the area is an estimate), and what marching tetrahedra on the Kuhn split makes
+// per h² of surface (measured on smooth and CAD shapes: 8 to 9).
+constexpr double kTrianglesPerPoint = 1.5;
+constexpr double kTrianglesPerCubeArea = 9.0;
+// The coarsest cube, as a share of the median leaf: coarser grids lose thin parts of the
+// local fits (handles appear on the bunny at one cube per leaf).
+constexpr double kCubesPerLeaf = 0.75;
+// The finest cube the point density alone may ask for: time and memory at millions of points.
+constexpr double kFinestSizeCube = 1.0 / 128;
+// Sharp features (sharpen.hpp): how far, in cubes, a vertex may move onto a crease or
+// corner (a chamfer is about a cube wide; thin walls are at least 2.5 cubes thick).
+constexpr double kSharpenReach = 1.0;
+// Vertices on the surface (edge_root.hpp): a few evaluations of f per vertex bring |f| from
+// the interpolant's error (a share of a cube on curved parts) down to this share of a cube.
+constexpr int kRootSteps = 3;
+constexpr double kRootTolerance = 1e-4;
 
 // Memory model of polygonize, for GMPU_PARAM_MAX_MEMORY (upper estimates of the peak):
 //  - per grid block: the band flag, the far sign, the region label and flood-fill stack;
@@ -118,11 +137,14 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuck
         int32_t &s = slot[size_t(local(ai, aj, ak) * 8 + dir)];
         if (s >= 0) return uint32_t(s);
         const double va = value[size_t(local(ai, aj, ak))], vb = value[size_t(local(bi, bj, bk))];
-        const double t = std::clamp(va / (va - vb), 0.0, 1.0);
         const Eigen::Vector3d pa = g.corner(x0 + ai, y0 + aj, z0 + ak), pb = g.corner(x0 + bi, y0 + bj, z0 + bk);
+        const std::vector<uint32_t> &cube_leaves = lattice.leaves_at(i, j, k);  // the cube (i, j, k) holds the edge
+        const double t = edge_root(
+            va, vb, [&](double s) { return f.mpu().value_among(cube_leaves, pa + s * (pb - pa), nullptr); },
+            kRootSteps, kRootTolerance * g.h);
         const Eigen::Vector3d p = pa + t * (pb - pa);
         Eigen::Vector3d grad;
-        f.mpu().value_among(lattice.leaves_at(i, j, k), p, &grad);  // the cube (i, j, k) holds p
+        f.mpu().value_among(cube_leaves, p, &grad);
         s = int32_t(out.vertex_pos.size());
         out.vertex_pos.push_back(p);
         out.vertex_grad.push_back(grad);
@@ -166,9 +188,12 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuck
 
 }  // namespace
 
-int default_resolution(const Octree &tree) {
-    // Half the median size of the leaves that hold points: the grid then resolves every
-    // local fit with about two cubes across. Where leaves hold two sheets, the cube must
+int default_resolution(const Octree &tree, const PointMeasures &measures) {
+    // The cube that makes about kTrianglesPerPoint triangles per point, from the surface
+    // area the points stand for: marching tetrahedra makes about kTrianglesPerCubeArea
+    // triangles per cube face (h²) of surface. Capped at a share of the size of the leaves
+    // that hold points (the grid must still resolve every local fit), and kept above kFinestSizeCube
+    // (memory and time at millions of points). Where leaves hold two sheets, the cube must
     // also be well under their gap, or both sheets fall between two grid corners of the same
     // sign and vanish. The walls that set it must hold a real share of the points: a few
     // two-sheet leaves in a narrow slot would otherwise refine the whole grid.
@@ -184,7 +209,15 @@ int default_resolution(const Octree &tree) {
     }
     if (sizes.empty()) return 64;
     std::nth_element(sizes.begin(), sizes.begin() + long(sizes.size() / 2), sizes.end());
-    double h = 0.5 * sizes[sizes.size() / 2];
+    const double leaf = sizes[sizes.size() / 2];
+    double area = 0.0;
+    for (float a : measures.area) area += double(a);
+    // Without areas (nothing measured): two cubes across the median leaf.
+    double h = 0.5 * leaf;
+    if (area > 0.0) {
+        const double sized = std::sqrt(kTrianglesPerCubeArea * area / (kTrianglesPerPoint * double(measures.area.size())));
+        h = std::min(std::max(sized, kFinestSizeCube), kCubesPerLeaf * leaf);
+    }
     std::sort(walls.begin(), walls.end());
     double held = 0.0;
     for (const auto &w : walls)
@@ -202,7 +235,8 @@ Mesh polygonize(const SurfaceField &field, int resolution, const Params &params,
     // The steps' shares of the stage's progress: the grid and the point buckets, the blocks,
     // the weld, the cleanup.
     Progress grid_progress = progress.slice(0.0, 0.02), blocks_progress = progress.slice(0.02, 0.95),
-             weld_progress = progress.slice(0.95, 0.98), cleanup_progress = progress.slice(0.98, 1.0);
+             weld_progress = progress.slice(0.95, 0.97), cleanup_progress = progress.slice(0.97, 0.98),
+             sharpen_progress = progress.slice(0.98, 1.0);
     const double h = 1.0 / resolution, min_trust = 2.0 * h;
     // Before allocating anything: the grid alone, then with the band, must fit the budget.
     const double grid_blocks = BlockGrid::blocks_for(points, resolution, std::max(measures.widest_trust, min_trust));
@@ -243,6 +277,7 @@ Mesh polygonize(const SurfaceField &field, int resolution, const Params &params,
     Mesh mesh = weld(blocks, points.normalisation(), weld_progress, votes);
     progress.throw_if_cancelled();
     remove_unsupported_components(mesh, votes, kMinVotes, cleanup_progress);
+    sharpen_features(mesh, kSharpenReach * h / points.normalisation().scale, sharpen_progress);
     return mesh;  // the caller makes the final report, once the temporaries are freed
 }
 
