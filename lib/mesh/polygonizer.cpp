@@ -28,14 +28,15 @@ constexpr uint32_t kMinVotes = 15;
 constexpr double kCubesPerGap = 0.4;
 // Share of the points that two-sheet leaves must hold for their gap to set the grid.
 constexpr double kWallShare = 0.1;
-// Mesh size (default_resolution): triangles wanted per input point (under the 2 the mesh
-// may have, as the area is an estimate), and what marching tetrahedra on the Kuhn split makes
-// per h² of surface (measured on smooth and CAD shapes: 8 to 9).
-constexpr double kTrianglesPerPoint = 1.5;
+// Mesh size (default_resolution): triangles wanted per input point, and what marching
+// tetrahedra on the Kuhn split makes per h² of surface (measured on smooth and CAD shapes:
+// 8 to 9).
+constexpr double kTrianglesPerPoint = 5.0;
 constexpr double kTrianglesPerCubeArea = 9.0;
-// The coarsest cube, as a share of the median leaf: coarser grids lose thin parts of the
-// local fits (handles appear on the bunny at one cube per leaf).
-constexpr double kCubesPerLeaf = 0.75;
+// The coarsest cube, as a share of the median leaf (two cubes across a leaf): coarser
+// grids bridge close sheets of the fits and add handles (the noisy and the nonuniform 35k
+// bunny have one to three at 0.6 and 0.75 of a leaf).
+constexpr double kCubesPerLeaf = 0.5;
 // The finest cube the point density alone may ask for: time and memory at millions of points.
 constexpr double kFinestSizeCube = 1.0 / 128;
 // Sharp features (sharpen.hpp): how far, in cubes, a vertex may move onto a crease or
@@ -45,6 +46,9 @@ constexpr double kSharpenReach = 1.0;
 // the interpolant's error (a share of a cube on curved parts) down to this share of a cube.
 constexpr int kRootSteps = 3;
 constexpr double kRootTolerance = 1e-4;
+// Both apply when the noise estimate is under this share of a cube (clean data: σ̂ is 0 on
+// noiseless samples; the noisy corpus clouds have 0.3 to 1.3 cubes).
+constexpr double kCleanNoise = 0.05;
 
 // Memory model of polygonize, for GMPU_PARAM_MAX_MEMORY (upper estimates of the peak):
 //  - per grid block: the band flag, the far sign, the region label and flood-fill stack;
@@ -90,7 +94,7 @@ struct SubBlockLeaves {
 
 // Marching tetrahedra over one band block.
 void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuckets &buckets, const std::vector<int64_t> &band,
-                      size_t band_index, BlockOutput &out) {
+                      size_t band_index, int root_steps, BlockOutput &out) {
     const int64_t block = band[band_index];
     constexpr int C = B + 1;  // corners along a block's side
     thread_local std::vector<double> value(C * C * C);
@@ -141,7 +145,7 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuck
         const std::vector<uint32_t> &cube_leaves = lattice.leaves_at(i, j, k);  // the cube (i, j, k) holds the edge
         const double t = edge_root(
             va, vb, [&](double s) { return f.mpu().value_among(cube_leaves, pa + s * (pb - pa), nullptr); },
-            kRootSteps, kRootTolerance * g.h);
+            root_steps, kRootTolerance * g.h);
         const Eigen::Vector3d p = pa + t * (pb - pa);
         Eigen::Vector3d grad;
         f.mpu().value_among(cube_leaves, p, &grad);
@@ -189,11 +193,11 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuck
 }  // namespace
 
 int default_resolution(const Octree &tree, const PointMeasures &measures) {
-    // The cube that makes about kTrianglesPerPoint triangles per point, from the surface
-    // area the points stand for: marching tetrahedra makes about kTrianglesPerCubeArea
-    // triangles per cube face (h²) of surface. Capped at a share of the size of the leaves
-    // that hold points (the grid must still resolve every local fit), and kept above kFinestSizeCube
-    // (memory and time at millions of points). Where leaves hold two sheets, the cube must
+    // Half the median size of the leaves that hold points (the grid then resolves every
+    // local fit with about two cubes across), or finer where the points are dense: the cube
+    // that makes about kTrianglesPerPoint triangles per point, from the surface area the
+    // points stand for (marching tetrahedra makes about kTrianglesPerCubeArea triangles per
+    // h² of surface), down to kFinestSizeCube. Where leaves hold two sheets, the cube must
     // also be well under their gap, or both sheets fall between two grid corners of the same
     // sign and vanish. The walls that set it must hold a real share of the points: a few
     // two-sheet leaves in a narrow slot would otherwise refine the whole grid.
@@ -229,7 +233,7 @@ int default_resolution(const Octree &tree, const PointMeasures &measures) {
 }
 
 Mesh polygonize(const SurfaceField &field, int resolution, const Params &params, Workers &workers,
-                Progress &progress) {
+                Progress &progress, double noise) {
     const PointSet &points = field.points();
     const PointMeasures &measures = field.measures();
     // The steps' shares of the stage's progress: the grid and the point buckets, the blocks,
@@ -238,6 +242,7 @@ Mesh polygonize(const SurfaceField &field, int resolution, const Params &params,
              weld_progress = progress.slice(0.95, 0.97), cleanup_progress = progress.slice(0.97, 0.98),
              sharpen_progress = progress.slice(0.98, 1.0);
     const double h = 1.0 / resolution, min_trust = 2.0 * h;
+    const bool clean = noise < kCleanNoise * h;
     // Before allocating anything: the grid alone, then with the band, must fit the budget.
     const double grid_blocks = BlockGrid::blocks_for(points, resolution, std::max(measures.widest_trust, min_trust));
     check_memory(polygonize_memory(grid_blocks, 0, 0), params.max_memory, resolution_text(resolution).c_str());
@@ -259,7 +264,7 @@ Mesh polygonize(const SurfaceField &field, int resolution, const Params &params,
     std::vector<BlockOutput> blocks(band.size());
     std::atomic<uint64_t> triangles{0};
     parallel_for(0, band.size(), workers, blocks_progress, [&](size_t i) {
-        polygonize_block(g, f, buckets, band, i, blocks[i]);
+        polygonize_block(g, f, buckets, band, i, clean ? kRootSteps : 0, blocks[i]);
         const uint64_t made = blocks[i].triangles.size() / 3;
         const double so_far = double(triangles.fetch_add(made) + made);
         if (so_far > params.max_triangles)
@@ -277,7 +282,7 @@ Mesh polygonize(const SurfaceField &field, int resolution, const Params &params,
     Mesh mesh = weld(blocks, points.normalisation(), weld_progress, votes);
     progress.throw_if_cancelled();
     remove_unsupported_components(mesh, votes, kMinVotes, cleanup_progress);
-    sharpen_features(mesh, kSharpenReach * h / points.normalisation().scale, sharpen_progress);
+    if (clean) sharpen_features(mesh, kSharpenReach * h / points.normalisation().scale, sharpen_progress);
     return mesh;  // the caller makes the final report, once the temporaries are freed
 }
 

@@ -72,7 +72,7 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
 Mesh Reconstruction::polygonize(const Params &params, int resolution, Progress &progress) {
     Workers &pool = workers(params.threads);
     progress.report(0.0, true);
-    Mesh mesh = gmpu::polygonize(field(params.level), resolution, params, pool, progress);
+    Mesh mesh = gmpu::polygonize(field(params.level), resolution, params, pool, progress, noise);
     return mesh;  // the caller checks it and makes the final report
 }
 
