@@ -22,9 +22,10 @@ namespace gmpu {
 // local fit keeps a cube across) nor than the gap of a thin wall's two sheets.
 int default_resolution(const Octree &tree, const PointMeasures &measures);
 
-// `noise`: the fit's noise estimate σ̂ (normalised units). On clean data (σ̂ well under a
-// cube) vertices are put on f = 0 and onto sharp edges; under noise f's zero set is bumpy
-// and the linear interpolant between grid corners, which smooths it, is the better mesh.
+// `noise`: the fit's noise estimate σ̂ (normalised units). On clean, dense data (σ̂ well
+// under a cube, samples closer than a cube) vertices are put on f = 0 and onto sharp edges;
+// under noise or between sparse samples f's zero set is a rougher guess and the linear
+// interpolant between grid corners, which smooths it, is the better mesh.
 // Throws CANCELLED or LIMIT_EXCEEDED (params.max_triangles).
 Mesh polygonize(const SurfaceField &field, int resolution, const Params &params, Workers &workers,
                 Progress &progress, double noise = 0.0);
