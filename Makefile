@@ -207,8 +207,9 @@ bench: deps-bench build
 	$(PYTHON) tests/bench/update_readme.py bench-results
 	$(MAKE) --no-print-directory bench-meshes
 
-# Decimation, level-of-detail topology and trimmed open scans (tests/bench/mesh_ops.py;
-# the trim rows need the corpus clouds the corpus section generates).
+# Decimation, level-of-detail topology, trimmed open scans, mesh size and polygonize share,
+# the bunny at 35k and 1M points, sharp-edge normal error (tests/bench/mesh_ops.py;
+# the trim, size and sharp rows on corpus clouds need the clouds the corpus section generates).
 .PHONY: bench-meshes
 bench-meshes: deps-bench build
 	$(PYTHON) tests/bench/mesh_ops.py --build $(BUILD) --out bench-results/mesh_ops

@@ -8,9 +8,11 @@
 #include "core/memory_budget.hpp"
 #include "core/parallel.hpp"
 #include "mesh/block_grid.hpp"
+#include "mesh/edge_root.hpp"
 #include "mesh/marching_tetrahedra.hpp"
 #include "mesh/mesh_cleanup.hpp"
 #include "mesh/point_buckets.hpp"
+#include "mesh/sharpen.hpp"
 #include "mesh/weld.hpp"
 
 namespace gmpu {
@@ -26,6 +28,37 @@ constexpr uint32_t kMinVotes = 15;
 constexpr double kCubesPerGap = 0.4;
 // Share of the points that two-sheet leaves must hold for their gap to set the grid.
 constexpr double kWallShare = 0.1;
+// Mesh size (default_resolution): triangles wanted per input point, and what marching
+// tetrahedra on the Kuhn split makes per h² of surface (measured on smooth and CAD shapes:
+// 8 to 9). At 5 the thin 35k camel was refined past two cubes per leaf and gained a handle.
+constexpr double kTrianglesPerPoint = 2.5;
+constexpr double kTrianglesPerCubeArea = 9.0;
+// The coarsest cube, as a share of the median leaf (two cubes across a leaf): coarser
+// grids bridge close sheets of the fits and add handles (the noisy and the nonuniform 35k
+// bunny have one to three at 0.6 and 0.75 of a leaf).
+constexpr double kCubesPerLeaf = 0.5;
+// The finest cube the point density alone may ask for: time and memory at millions of points.
+constexpr double kFinestSizeCube = 1.0 / 128;
+// Sharp features (sharpen.hpp): how far, in cubes, a vertex may move onto a crease or
+// corner (a chamfer is about a cube wide; thin walls are at least 2.5 cubes thick).
+constexpr double kSharpenReach = 1.0;
+// Vertices on the surface (edge_root.hpp): a few evaluations of f per vertex bring |f| from
+// the interpolant's error (a share of a cube on curved parts) down to this share of a cube.
+constexpr int kRootSteps = 3;
+constexpr double kRootTolerance = 1e-4;
+// Both apply when the noise estimate is under this share of a cube (clean data: σ̂ is 0 on
+// noiseless samples; the noisy corpus clouds have 0.3 to 1.3 cubes) and the mean sample
+// spacing is under a cube (between sparser samples f is a guess the interpolant smooths:
+// the 5k-point thin plate lost 0.01 of F@1 % with them).
+constexpr double kCleanNoise = 0.05;
+constexpr double kDenseSpacing = 1.0;
+
+// Mean sample spacing: the square root of the area each point stands for.
+double mean_spacing(const PointMeasures &measures) {
+    double area = 0.0;
+    for (float a : measures.area) area += double(a);
+    return measures.area.empty() ? INFINITY : std::sqrt(area / double(measures.area.size()));
+}
 
 // Memory model of polygonize, for GMPU_PARAM_MAX_MEMORY (upper estimates of the peak):
 //  - per grid block: the band flag, the far sign, the region label and flood-fill stack;
@@ -71,7 +104,7 @@ struct SubBlockLeaves {
 
 // Marching tetrahedra over one band block.
 void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuckets &buckets, const std::vector<int64_t> &band,
-                      size_t band_index, BlockOutput &out) {
+                      size_t band_index, int root_steps, BlockOutput &out) {
     const int64_t block = band[band_index];
     constexpr int C = B + 1;  // corners along a block's side
     thread_local std::vector<double> value(C * C * C);
@@ -118,11 +151,14 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuck
         int32_t &s = slot[size_t(local(ai, aj, ak) * 8 + dir)];
         if (s >= 0) return uint32_t(s);
         const double va = value[size_t(local(ai, aj, ak))], vb = value[size_t(local(bi, bj, bk))];
-        const double t = std::clamp(va / (va - vb), 0.0, 1.0);
         const Eigen::Vector3d pa = g.corner(x0 + ai, y0 + aj, z0 + ak), pb = g.corner(x0 + bi, y0 + bj, z0 + bk);
+        const std::vector<uint32_t> &cube_leaves = lattice.leaves_at(i, j, k);  // the cube (i, j, k) holds the edge
+        const double t = edge_root(
+            va, vb, [&](double s) { return f.mpu().value_among(cube_leaves, pa + s * (pb - pa), nullptr); },
+            root_steps, kRootTolerance * g.h);
         const Eigen::Vector3d p = pa + t * (pb - pa);
         Eigen::Vector3d grad;
-        f.mpu().value_among(lattice.leaves_at(i, j, k), p, &grad);  // the cube (i, j, k) holds p
+        f.mpu().value_among(cube_leaves, p, &grad);
         s = int32_t(out.vertex_pos.size());
         out.vertex_pos.push_back(p);
         out.vertex_grad.push_back(grad);
@@ -166,9 +202,12 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuck
 
 }  // namespace
 
-int default_resolution(const Octree &tree) {
-    // Half the median size of the leaves that hold points: the grid then resolves every
-    // local fit with about two cubes across. Where leaves hold two sheets, the cube must
+int default_resolution(const Octree &tree, const PointMeasures &measures) {
+    // Half the median size of the leaves that hold points (the grid then resolves every
+    // local fit with about two cubes across), or finer where the points are dense: the cube
+    // that makes about kTrianglesPerPoint triangles per point, from the surface area the
+    // points stand for (marching tetrahedra makes about kTrianglesPerCubeArea triangles per
+    // h² of surface), down to kFinestSizeCube. Where leaves hold two sheets, the cube must
     // also be well under their gap, or both sheets fall between two grid corners of the same
     // sign and vanish. The walls that set it must hold a real share of the points: a few
     // two-sheet leaves in a narrow slot would otherwise refine the whole grid.
@@ -184,7 +223,15 @@ int default_resolution(const Octree &tree) {
     }
     if (sizes.empty()) return 64;
     std::nth_element(sizes.begin(), sizes.begin() + long(sizes.size() / 2), sizes.end());
-    double h = 0.5 * sizes[sizes.size() / 2];
+    const double leaf = sizes[sizes.size() / 2];
+    double area = 0.0;
+    for (float a : measures.area) area += double(a);
+    // Without areas (nothing measured): two cubes across the median leaf.
+    double h = 0.5 * leaf;
+    if (area > 0.0) {
+        const double sized = std::sqrt(kTrianglesPerCubeArea * area / (kTrianglesPerPoint * double(measures.area.size())));
+        h = std::min(std::max(sized, kFinestSizeCube), kCubesPerLeaf * leaf);
+    }
     std::sort(walls.begin(), walls.end());
     double held = 0.0;
     for (const auto &w : walls)
@@ -196,14 +243,16 @@ int default_resolution(const Octree &tree) {
 }
 
 Mesh polygonize(const SurfaceField &field, int resolution, const Params &params, Workers &workers,
-                Progress &progress) {
+                Progress &progress, double noise) {
     const PointSet &points = field.points();
     const PointMeasures &measures = field.measures();
     // The steps' shares of the stage's progress: the grid and the point buckets, the blocks,
     // the weld, the cleanup.
     Progress grid_progress = progress.slice(0.0, 0.02), blocks_progress = progress.slice(0.02, 0.95),
-             weld_progress = progress.slice(0.95, 0.98), cleanup_progress = progress.slice(0.98, 1.0);
+             weld_progress = progress.slice(0.95, 0.97), cleanup_progress = progress.slice(0.97, 0.98),
+             sharpen_progress = progress.slice(0.98, 1.0);
     const double h = 1.0 / resolution, min_trust = 2.0 * h;
+    const bool clean = noise < kCleanNoise * h && mean_spacing(measures) < kDenseSpacing * h;
     // Before allocating anything: the grid alone, then with the band, must fit the budget.
     const double grid_blocks = BlockGrid::blocks_for(points, resolution, std::max(measures.widest_trust, min_trust));
     check_memory(polygonize_memory(grid_blocks, 0, 0), params.max_memory, resolution_text(resolution).c_str());
@@ -225,7 +274,7 @@ Mesh polygonize(const SurfaceField &field, int resolution, const Params &params,
     std::vector<BlockOutput> blocks(band.size());
     std::atomic<uint64_t> triangles{0};
     parallel_for(0, band.size(), workers, blocks_progress, [&](size_t i) {
-        polygonize_block(g, f, buckets, band, i, blocks[i]);
+        polygonize_block(g, f, buckets, band, i, clean ? kRootSteps : 0, blocks[i]);
         const uint64_t made = blocks[i].triangles.size() / 3;
         const double so_far = double(triangles.fetch_add(made) + made);
         if (so_far > params.max_triangles)
@@ -243,6 +292,7 @@ Mesh polygonize(const SurfaceField &field, int resolution, const Params &params,
     Mesh mesh = weld(blocks, points.normalisation(), weld_progress, votes);
     progress.throw_if_cancelled();
     remove_unsupported_components(mesh, votes, kMinVotes, cleanup_progress);
+    if (clean) sharpen_features(mesh, kSharpenReach * h / points.normalisation().scale, sharpen_progress);
     return mesh;  // the caller makes the final report, once the temporaries are freed
 }
 

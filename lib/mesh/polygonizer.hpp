@@ -16,11 +16,18 @@
 
 namespace gmpu {
 
-// Grid resolution (cubes along the longest side) that keeps the detail of the octree.
-int default_resolution(const Octree &tree);
+// Grid resolution (cubes along the longest side) that follows the data: cubes about the
+// size that gives a mesh of kTrianglesPerPoint triangles per input point (from the points'
+// areas, so dense data gets a finer grid), never coarser than the octree's leaves (every
+// local fit keeps a cube across) nor than the gap of a thin wall's two sheets.
+int default_resolution(const Octree &tree, const PointMeasures &measures);
 
+// `noise`: the fit's noise estimate σ̂ (normalised units). On clean, dense data (σ̂ well
+// under a cube, samples closer than a cube) vertices are put on f = 0 and onto sharp edges;
+// under noise or between sparse samples f's zero set is a rougher guess and the linear
+// interpolant between grid corners, which smooths it, is the better mesh.
 // Throws CANCELLED or LIMIT_EXCEEDED (params.max_triangles).
 Mesh polygonize(const SurfaceField &field, int resolution, const Params &params, Workers &workers,
-                Progress &progress);
+                Progress &progress, double noise = 0.0);
 
 }  // namespace gmpu

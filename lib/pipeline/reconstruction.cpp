@@ -89,15 +89,15 @@ Mesh Reconstruction::polygonize(const Params &params, int resolution, Progress &
                      ? solve_smooth_surface(params, tree, points, measures, noise, smooth_progress)
                      : nullptr;
         Progress rest = progress.slice(0.3, 1.0);
-        return gmpu::polygonize(field(params.level), resolution, params, pool, rest);
+        return gmpu::polygonize(field(params.level), resolution, params, pool, rest, noise);
     }
-    Mesh mesh = gmpu::polygonize(field(params.level), resolution, params, pool, progress);
+    Mesh mesh = gmpu::polygonize(field(params.level), resolution, params, pool, progress, noise);
     return mesh;  // the caller checks it and makes the final report
 }
 
 int Reconstruction::default_resolution(const Params &params) const {
     return wants_smooth_surface(params, points, noise) ? smooth_resolution(tree, measures)
-                                                       : gmpu::default_resolution(tree);
+                                                       : gmpu::default_resolution(tree, measures);
 }
 
 void Reconstruction::evaluate(const Params &params, const double *xyz, size_t count, double *values,

@@ -28,11 +28,11 @@ int smooth_resolution(const Octree &tree, const PointMeasures &measures) {
     // noise-averaged surface still has. The smooth grid is at least as fine as the points'
     // typical spacing (the square root of the median area a point stands for).
     std::vector<float> area(measures.area);
-    if (area.empty()) return default_resolution(tree);
+    if (area.empty()) return default_resolution(tree, measures);
     std::nth_element(area.begin(), area.begin() + long(area.size() / 2), area.end());
     const double spacing = std::sqrt(double(area[area.size() / 2]));
     const int from_spacing = spacing > 0.0 ? int(std::ceil(1.0 / spacing)) : 0;
-    return std::clamp(std::max(default_resolution(tree), from_spacing), 8, kMaxResolution);
+    return std::clamp(std::max(default_resolution(tree, measures), from_spacing), 8, kMaxResolution);
 }
 
 bool wants_smooth_surface(const Params &params, const PointSet &points, double noise) {

@@ -7,14 +7,21 @@
   trim        the open corpus scans (elephant-with-holes, mech-holes-shark) with --trim,
               precision / recall at 0.5 %, against Open3D's Poisson (depth 8) with the 5 %
               lowest-density vertices removed (the usual density trim).
+  size        every 35k-point cloud (shared clouds and the corpus, --clouds filters by name):
+              triangles per input point, F@0.5 %, normal consistency, and polygonize's share
+              of the end-to-end time (the CLI's own timing line);
+  dense       the bunny sampled at 35k and 1M points: Chamfer-L1 and triangles of each;
+  sharp       fandisk and the corpus CAD parts: mean angle between the output's normals and
+              the true normals within 1 % of the diagonal of a sharp edge (sharp_edges.py).
 
     /usr/bin/python3 tests/bench/mesh_ops.py --build build --out bench-results/mesh_ops \
-        [--sections decimation,lod,trim] [--corpus /path/to/corpus]
+        [--sections decimation,lod,trim,size,dense,sharp] [--corpus /path/to/corpus] [--clouds a,b]
 
 Writes results.json and prints a Markdown table per section.
 """
 import argparse
 import json
+import re
 import subprocess
 import sys
 import tempfile
@@ -150,15 +157,108 @@ def trim(args, tmp):
     return rows
 
 
+def timed_reconstruct(cli, cloud, out):
+    """Reconstructs without --quiet and returns (polygonize seconds, total seconds)."""
+    done = subprocess.run([str(cli), str(cloud), "-o", str(out)], capture_output=True, text=True)
+    if done.returncode != 0:
+        raise RuntimeError(f"{cloud}: {done.stderr.strip()}")
+    m = re.search(r"polygonize ([0-9.]+) s.*total ([0-9.]+) s", done.stderr)
+    return float(m.group(1)), float(m.group(2))
+
+
+def points_of(ply):
+    with open(ply, "rb") as f:
+        for line in f:
+            if line.startswith(b"element vertex"):
+                return int(line.split()[2])
+    raise ValueError(f"{ply}: no vertex element")
+
+
+def chosen(args, clouds):
+    if not args.clouds:
+        return clouds
+    return [c for c in clouds if any(w in c.stem for w in args.clouds)]
+
+
+def size(args, tmp):
+    clouds = [p for p in sorted(CLOUDS.glob("*.ply")) + sorted(args.corpus.glob("*.ply"))
+              if not p.stem.endswith("_gt") and gt_mesh_of(p) and points_of(p) == 35000]
+    rows = []
+    for cloud in chosen(args, clouds):
+        out = tmp / f"{cloud.stem}_size.ply"
+        poly, total = timed_reconstruct(args.cli, cloud, out)
+        m = metrics(args.metrics, out, gt_mesh_of(cloud))
+        rows.append({"cloud": cloud.stem, "points": 35000, "triangles": m["triangles"],
+                     "triangles_per_point": m["triangles"] / 35000, "fscore_0.5": m.get("fscore_0.5"),
+                     "normal_consistency": m.get("normal_consistency"), "polygonize_seconds": poly,
+                     "total_seconds": total, "polygonize_share": poly / total, "watertight": m["watertight"]})
+        print(rows[-1], flush=True)
+    print("\n| cloud | triangles / point | F@0.5 % | normal consistency | polygonize s | total s | share | watertight |")
+    print("|---|---|---|---|---|---|---|---|")
+    for r in rows:
+        print(f"| {r['cloud']} | {r['triangles_per_point']:.2f} | {r['fscore_0.5']:.4f} | {r['normal_consistency']:.4f} | "
+              f"{r['polygonize_seconds']:.2f} | {r['total_seconds']:.2f} | {100 * r['polygonize_share']:.0f} % | {r['watertight']} |")
+    return rows
+
+
+def dense(args, tmp):
+    gt = MESHES / "bunny00.off"
+    rows = []
+    for n in (35_000, 1_000_000):
+        cloud, truth = tmp / f"bunny_{n}.ply", tmp / f"bunny_{n}_gt.ply"
+        subprocess.run([str(args.metrics), "--sample", str(gt), "--n", str(n), "--seed", "1", "-o", str(cloud),
+                        "--gt-out", str(truth)], capture_output=True, check=True)
+        out = tmp / f"bunny_{n}_mesh.ply"
+        poly, total = timed_reconstruct(args.cli, cloud, out)
+        m = metrics(args.metrics, out, gt)
+        rows.append({"points": n, "triangles": m["triangles"], "chamfer_l1": m["chamfer_l1"],
+                     "fscore_0.5": m.get("fscore_0.5"), "polygonize_seconds": poly, "total_seconds": total})
+        print(rows[-1], flush=True)
+    print("\n| bunny points | triangles | Chamfer-L1 | F@0.5 % | polygonize s | total s |")
+    print("|---|---|---|---|---|---|")
+    for r in rows:
+        print(f"| {r['points']} | {r['triangles']} | {r['chamfer_l1']:.6f} | {r['fscore_0.5']:.4f} | "
+              f"{r['polygonize_seconds']:.2f} | {r['total_seconds']:.2f} |")
+    return rows
+
+
+SHARP_PARTS = ("fandisk_clean", "pinion_clean", "rotor_clean", "couplingdown_clean", "spool_clean")
+
+
+def sharp(args, tmp):
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from sharp_edges import sharp_edge_angle
+    rows = []
+    for name in SHARP_PARTS:
+        cloud = next((d / f"{name}.ply" for d in (CLOUDS, args.corpus) if (d / f"{name}.ply").exists()), None)
+        if cloud is None:
+            print(f"sharp: {name} skipped, not in {CLOUDS} nor {args.corpus}")
+            continue
+        out = tmp / f"{name}_sharp.ply"
+        reconstruct(args.cli, cloud, out)
+        r = sharp_edge_angle(out, gt_mesh_of(cloud))
+        m = metrics(args.metrics, out)
+        rows.append({"cloud": name, **r, "watertight": m["watertight"], "edge_manifold": m["edge_manifold"],
+                     "consistently_wound": m["consistently_wound"], "signed_volume": m["signed_volume"]})
+        print(rows[-1], flush=True)
+    print("\n| part | mean normal error within 1 % of a sharp edge (°) | triangles there | watertight |")
+    print("|---|---|---|---|")
+    for r in rows:
+        print(f"| {r['cloud']} | {r['sharp_edge_angle']:.2f} | {r['triangles_near_edges']} | {r['watertight']} |")
+    return rows
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--build", type=Path, default=ROOT / "build")
     ap.add_argument("--out", type=Path, default=ROOT / "bench-results" / "mesh_ops")
-    ap.add_argument("--sections", default="decimation,lod,trim")
+    ap.add_argument("--sections", default="decimation,lod,trim,size,dense,sharp")
     ap.add_argument("--corpus", type=Path, default=ROOT / "bench-results" / "corpus" / "clouds",
                     help="directory of the generated corpus clouds (tests/data/corpus/make.sh)")
     ap.add_argument("--trim-values", type=lambda s: [float(x) for x in s.split(",") if x], default=[2.0, 1.5])
     ap.add_argument("--no-open3d", dest="open3d", action="store_false")
+    ap.add_argument("--clouds", type=lambda s: [x for x in s.split(",") if x], default=[],
+                    help="size: only the clouds whose name holds one of these")
     args = ap.parse_args()
     args.cli = args.build / "examples" / "gmpu-reconstruct"
     args.metrics = args.build / "tests" / "bench" / "gmpu-metrics"
@@ -166,7 +266,8 @@ def main():
     results = {}
     with tempfile.TemporaryDirectory(dir=args.out) as t:
         for section in args.sections.split(","):
-            results[section] = {"decimation": decimation, "lod": lod, "trim": trim}[section](args, Path(t))
+            results[section] = {"decimation": decimation, "lod": lod, "trim": trim, "size": size, "dense": dense,
+                                "sharp": sharp}[section](args, Path(t))
     (args.out / "results.json").write_text(json.dumps(results, indent=1, default=str))
     return 0
 
