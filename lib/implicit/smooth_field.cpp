@@ -123,7 +123,7 @@ void SmoothField::solve(const PointSet &points, const PointMeasures &measures, d
         int64_t lo[3], hi[3];
         node_box(i, lo, hi);
         const Eigen::Vector3d p = points.point(i);
-        const Eigen::Vector3d nrm(measures.normals[3 * i], measures.normals[3 * i + 1], measures.normals[3 * i + 2]);
+        const Eigen::Vector3d nrm(measures.blend_normals[3 * i], measures.blend_normals[3 * i + 1], measures.blend_normals[3 * i + 2]);
         const double r = radius(i), r2 = r * r;
         for (int64_t z = lo[2]; z <= hi[2]; ++z)
             for (int64_t y = lo[1]; y <= hi[1]; ++y)
