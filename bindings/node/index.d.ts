@@ -93,6 +93,8 @@ export interface Parameters {
     maxMemory?: number;
     /** 1: set_points leaves the outliers it finds out of the fit; 0: fits them too (GMPU_STAT_OUTLIERS counts them either way). Default 1, 0..1. */
     removeOutliers?: boolean | number;
+    /** The surface: 0 the MPU blend, 1 a smooth field solved from the oriented points, 2 chosen from the estimated noise (the smooth one from 0.3 % of the diagonal). Default 2. */
+    surface?: number;
 }
 export type ParameterName = keyof Parameters;
 export declare const parameterNames: readonly ParameterName[];

@@ -52,7 +52,8 @@ fn typed_builder_sets_every_parameter_and_is_checked_by_the_library_table() {
         .max_triangles(1e7)
         .noise_scale(1.5)
         .max_memory(1e9)
-        .remove_outliers(false);
+        .remove_outliers(false)
+        .surface(1);
     let mut keys: Vec<u32> = all.iter().map(|(k, _)| k.to_raw()).collect();
     keys.sort_unstable();
     assert_eq!(keys, Param::ALL.iter().map(|p| p.to_raw()).collect::<Vec<_>>(), "a Param without a setter");
