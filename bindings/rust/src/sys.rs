@@ -73,9 +73,9 @@ macro_rules! c_functions {
 
 /// `#define`d integer constants of the header.
 pub const GMPU_VERSION_MAJOR: u32 = 0;
-pub const GMPU_VERSION_MINOR: u32 = 3;
+pub const GMPU_VERSION_MINOR: u32 = 4;
 pub const GMPU_VERSION_PATCH: u32 = 0;
-pub const GMPU_VERSION_NUMBER: u32 = 300;
+pub const GMPU_VERSION_NUMBER: u32 = 400;
 pub const GMPU_ABI_VERSION: u32 = 1;
 pub const DEFINES: &[(&str, u32)] = &[
     ("GMPU_VERSION_MAJOR", GMPU_VERSION_MAJOR),
@@ -242,6 +242,12 @@ c_functions! {
     pub fn gmpu_mesh_simplify(mesh: *const gmpu_mesh, target_triangles: usize, target_error: f64,
                               out: *mut *mut gmpu_mesh) -> gmpu_status;
     pub fn gmpu_mesh_trim(mesh: *const gmpu_mesh, threshold: f64, out: *mut *mut gmpu_mesh) -> gmpu_status;
+
+    pub fn gmpu_surface_evaluate_grid(surface: *const gmpu_surface, grid_origin: *const f64, cell_size: f64,
+        blocks: *const i64, block_count: usize, values: *mut f64) -> gmpu_status;
+    pub fn gmpu_grid_polygonize(grid_origin: *const f64, cell_size: f64, grid_cells: *const i64, blocks: *const i64,
+        block_count: usize, corner_values: *const f64, out: *mut *mut gmpu_mesh) -> gmpu_status;
+    pub fn gmpu_mesh_grid_keys(mesh: *const gmpu_mesh) -> *const u64;
 
     pub fn gmpu_points_read(path: *const c_char, out: *mut *mut gmpu_points) -> gmpu_status;
     pub fn gmpu_points_read_with(
