@@ -3,7 +3,7 @@
     >>> from gmpu.dask import reconstruct                     # doctest: +SKIP
     >>> mesh = reconstruct("city.ply", client=client)         # doctest: +SKIP
 
-    python3 -m gmpu.dask INPUT -o OUT [--scheduler ADDRESS | --local-workers N]
+    python3 -m gmpu.dask INPUT -o OUT [--scheduler ADDRESS | --local-workers N [--in-process]]
 
 How (issue 17):
 
@@ -183,8 +183,9 @@ def _spacing(sample: np.ndarray, total: int) -> float:
 
 def plan_tiles(sample: np.ndarray, total: int, lo: np.ndarray, hi: np.ndarray, *, tile_points: int,
                resolution: int = 0, band_cells: float = 3.0, margin_cells: float = 16.0) -> TilePlan:
-    """The grid and a kd split of its blocks into tiles of about `tile_points` points (the
-    sample's share of `total` stands for the cloud)."""
+    """The grid and a kd split of its blocks (at the sample's median, on block boundaries)
+    into 2^k tiles of at most about `tile_points` points each (the sample stands for the
+    `total` points of the cloud)."""
     extent = hi - lo
     if resolution > 0:
         cell = float(extent.max()) / resolution
@@ -196,12 +197,14 @@ def plan_tiles(sample: np.ndarray, total: int, lo: np.ndarray, hi: np.ndarray, *
     origin = lo - pad
     cells = (np.ceil((extent + 2 * pad) / (BLOCK * cell)).astype(np.int64) * BLOCK)
     grid = Grid(origin, cell, cells)
-    weight = total / max(len(sample), 1)
     sample_blocks = np.floor((sample - origin) / (BLOCK * cell)).astype(np.int64)
     tiles = []
 
-    def split(bl, bh, members):
-        if len(members) * weight <= tile_points or np.all(bh - bl <= 1):
+    # Every tile split to the same depth: 2^depth tiles, each about total / 2^depth points.
+    depth = int(np.ceil(np.log2(max(total / tile_points, 1.0))))
+
+    def split(bl, bh, members, level=0):
+        if level >= depth or np.all(bh - bl <= 1):
             tiles.append((bl, bh))
             return
         sizes = bh - bl
@@ -212,8 +215,8 @@ def plan_tiles(sample: np.ndarray, total: int, lo: np.ndarray, hi: np.ndarray, *
         high = members[sample_blocks[members, axis] >= cut]
         h1 = bh.copy(); h1[axis] = cut
         l2 = bl.copy(); l2[axis] = cut
-        split(bl, h1, low)
-        split(l2, bh, high)
+        split(bl, h1, low, level + 1)
+        split(l2, bh, high, level + 1)
 
     split(np.zeros(3, np.int64), grid.blocks.copy(), np.arange(len(sample)))
     return TilePlan(grid, tiles, margin, band_radius)
@@ -274,7 +277,7 @@ def _tile_surface(source: Any, plan: TilePlan, tile: int, params: Dict[str, Any]
         s.fit()
         s.orient()
         values = _evaluate_grid(s, g, g.block_of_key(keys))
-        normals = s.normals()
+        normals = s.normals
     if reverse:
         values, normals = -values, -normals
     v = values.reshape(-1, BLOCK, BLOCK, BLOCK)  # [block, k, j, i]
@@ -640,13 +643,15 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     parser.add_argument("--tile-points", type=int, default=2_000_000)
     parser.add_argument("--resolution", type=int, default=0)
     parser.add_argument("--threads-per-worker", type=int, default=1)
+    parser.add_argument("--in-process", action="store_true",
+                        help="local workers as threads of this process (starts faster; one process's memory)")
     args = parser.parse_args(argv)
     from distributed import Client, LocalCluster
     if args.scheduler:
         client, cluster = Client(args.scheduler), None
     else:
         cluster = LocalCluster(n_workers=args.local_workers, threads_per_worker=args.threads_per_worker,
-                               processes=True, dashboard_address=None)
+                               processes=not args.in_process, dashboard_address=None)
         client = Client(cluster)
     try:
         stats: Dict[str, Any] = {}
@@ -662,4 +667,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
 
 
 if __name__ == "__main__":
-    sys.exit(main())
+    # Run from the package's module, not this __main__ copy: tasks must name their functions
+    # by an importable module, or Dask pickles them with their globals (the C library).
+    from gmpu.dask import main as _main
+    sys.exit(_main())
