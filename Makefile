@@ -219,7 +219,7 @@ bench-meshes: deps-bench build
 DASK_POINTS ?= 10000000
 .PHONY: bench-dask
 bench-dask: deps-bench build
-	$(PYTHON) tests/bench/dask_bench.py --build $(BUILD) --out bench-results/dask --points $(DASK_POINTS)
+	$(PYTHON) tests/bench/dask_bench.py --build $(BUILD) --out bench-results/dask --points $(DASK_POINTS) --kill-check 1000000
 
 # The corpus section alone (issue 13's targets on 106 generated clouds).
 bench-corpus: deps-bench build

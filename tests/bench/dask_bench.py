@@ -128,6 +128,37 @@ def tiled_run(cloud, resolution, tile_points, workers):
     return mesh, wall, sorted(peaks.values()), driver, stats
 
 
+def kill_check(cloud, resolution, tile_points, workers):
+    """Fault tolerance: the tiled run again, with one worker process killed (SIGKILL) part way
+    through its first phase; the nanny restarts it, Dask recomputes what it held, and the mesh
+    must be identical to an undisturbed run's."""
+    import signal
+    import threading
+    from distributed import Client, LocalCluster
+    import gmpu.dask as gd
+    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                           memory_limit=0)
+    client = Client(cluster)
+    try:
+        stats = {}
+        t = time.perf_counter()
+        clean = gd.reconstruct(str(cloud), client, tile_points=tile_points, resolution=resolution, stats=stats,
+                               threads=1)
+        first_phase = stats["phase1_seconds"]
+        pid = sorted(client.run(os.getpid).values())[0]
+        killer = threading.Timer(0.5 * first_phase, lambda: os.kill(pid, signal.SIGKILL))
+        killer.start()
+        disturbed = gd.reconstruct(str(cloud), client, tile_points=tile_points, resolution=resolution, threads=1)
+        killer.join()
+        restarted = pid not in client.run(os.getpid).values()
+    finally:
+        client.close()
+        cluster.close()
+    same = (np.array_equal(np.asarray(clean.vertices), np.asarray(disturbed.vertices)) and
+            np.array_equal(np.asarray(clean.faces), np.asarray(disturbed.faces)))
+    return same, restarted, time.perf_counter() - t
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", default="build")
@@ -135,6 +166,8 @@ def main():
     ap.add_argument("--points", type=int, default=10_000_000)
     ap.add_argument("--tile-points", type=int, default=1_000_000)
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--kill-check", type=int, default=0,
+                    help="points of a cloud on which a worker is killed mid-run (0: no check)")
     args = ap.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -164,6 +197,14 @@ def main():
           f"{driver / 1e9:.2f} GB; {stats['tiles']} tiles; boundary {boundary}, non-manifold {nonmanifold}, "
           f"components {mesh.components}, genus {mesh.genus}; Chamfer {100 * cham / diagonal:.4f} % of the diagonal; "
           f"orientation agreement {100 * agree:.3f} %", flush=True)
+    if args.kill_check:
+        small = out / f"bunny_{args.kill_check}.ply"
+        if not small.exists():
+            write_cloud(small, args.kill_check)
+        same, restarted, seconds = kill_check(small, resolution, max(args.kill_check // 4, 1), args.workers)
+        row.update(kill_check_points=args.kill_check, kill_check_identical=same, kill_check_worker_restarted=restarted)
+        print(f"killed a worker mid-run on {args.kill_check} points: worker restarted {restarted}, mesh identical "
+              f"{same} ({seconds:.0f} s for both runs)", flush=True)
     (out / "dask.json").write_text(json.dumps(row, indent=1))
     return 0
 

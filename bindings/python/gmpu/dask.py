@@ -53,7 +53,7 @@ _OWNED = BLOCK ** 3
 # The normals of at most this many overlap points per tile are compared with the neighbours'.
 _SHARED_SAMPLE = 20000
 # Points read per chunk when a tile scans a file.
-_CHUNK = 1 << 21
+_CHUNK = 1 << 19
 
 
 # ---- input ------------------------------------------------------------------------------
