@@ -170,3 +170,13 @@ def test_cli_on_a_memory_mapped_ply(tmp_path, data_dir):
     mesh = gmpu.read_points(out)  # the vertices, at least
     assert len(mesh) > 1000
     assert "tiles" in r.stdout
+
+
+def test_every_tile_reversed_is_turned_outward(cloud, untiled, client):
+    """All tiles turned over agree with each other, so only the outward pass (the band next
+    to the grid's outer far region must be outside) can put them right."""
+    mesh = gd.reconstruct(cloud, client, tile_points=TILE_POINTS, resolution=untiled[1], threads=1,
+                          _flip_tiles=range(8))
+    assert mesh.volume > 0
+    assert components_and_genus(mesh.faces, len(mesh.vertices)) == \
+        components_and_genus(untiled[0].faces, len(untiled[0].vertices))
