@@ -182,7 +182,7 @@ def _spacing(sample: np.ndarray, total: int) -> float:
 
 
 def plan_tiles(sample: np.ndarray, total: int, lo: np.ndarray, hi: np.ndarray, *, tile_points: int,
-               resolution: int = 0, band_cells: float = 3.0, margin_cells: float = 8.0) -> TilePlan:
+               resolution: int = 0, band_cells: float = 3.0, margin_cells: float = 16.0) -> TilePlan:
     """The grid and a kd split of its blocks (at the sample's median, on block boundaries)
     into 2^k tiles of at most about `tile_points` points each (the sample stands for the
     `total` points of the cloud)."""
@@ -544,7 +544,7 @@ def vertex_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
 
 
 def reconstruct(path_or_array: Any, client: Any = None, *, tile_points: int = 2_000_000, resolution: int = 0,
-                band_cells: float = 3.0, margin_cells: float = 8.0, min_component_share: float = 0.001,
+                band_cells: float = 3.0, margin_cells: float = 16.0, min_component_share: float = 0.001,
                 reconcile: bool = True, stats: Optional[Dict[str, Any]] = None, _flip_tiles: Sequence[int] = (),
                 **params: Any) -> Mesh:
     """The closed, outward-oriented mesh of a cloud (a PLY/XYZ path — binary little-endian
