@@ -11,7 +11,7 @@ DEMO_OUT := $(BUILD)/demo/bunny_mesh.ply
 
 # Debian packages each target needs; `deps-*` installs only the missing ones.
 CORE_PKGS := g++ pkg-config meson ninja-build libeigen3-dev libnanoflann-dev libcmocka-dev libmeshoptimizer-dev
-TEST_PKGS := $(CORE_PKGS) python3-cffi python3-numpy python3-pytest python3-matplotlib \
+TEST_PKGS := $(CORE_PKGS) python3-cffi python3-numpy python3-pytest python3-matplotlib python3-scipy python3-distributed \
              valgrind clang libclang-rt-14-dev time python3-open3d \
              cmake python3-venv python3-mesonpy python3-build
 BENCH_PKGS := $(TEST_PKGS) python3-open3d libcgal-dev libgmp-dev libmpfr-dev time
@@ -206,6 +206,7 @@ bench: deps-bench build
 	$(PYTHON) tests/bench/run_bench.py --corpus-only --corpus-peers $(CORPUS_PEERS) --build $(BUILD) --out bench-results
 	$(PYTHON) tests/bench/update_readme.py bench-results
 	$(MAKE) --no-print-directory bench-meshes
+	$(MAKE) --no-print-directory bench-dask
 
 # Decimation, level-of-detail topology, trimmed open scans, mesh size and polygonize share,
 # the bunny at 35k and 1M points, sharp-edge normal error (tests/bench/mesh_ops.py;
@@ -213,6 +214,13 @@ bench: deps-bench build
 .PHONY: bench-meshes
 bench-meshes: deps-bench build
 	$(PYTHON) tests/bench/mesh_ops.py --build $(BUILD) --out bench-results/mesh_ops
+
+# Tiled reconstruction on a 2-worker Dask LocalCluster against the one-process path, 10M points
+# (tests/bench/dask_bench.py; DASK_POINTS overrides the size).
+DASK_POINTS ?= 10000000
+.PHONY: bench-dask
+bench-dask: deps-bench build
+	$(PYTHON) tests/bench/dask_bench.py --build $(BUILD) --out bench-results/dask --points $(DASK_POINTS) --kill-check 1000000
 
 # The corpus section alone (issue 13's targets on 106 generated clouds).
 bench-corpus: deps-bench build

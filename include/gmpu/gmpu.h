@@ -54,7 +54,8 @@
  *   0.4: meshes from arrays with normals, confidence, colours (gmpu_mesh_create_with);
  *        colours of PLY points and of meshes (gmpu_points_colors, gmpu_points_create_with,
  *        gmpu_mesh_colors, gmpu_mesh_color_from_points); statistics' names
- *        (gmpu_stat_count, gmpu_stat_name). */
+ *        (gmpu_stat_count, gmpu_stat_name); tiles on a shared grid
+ *        (gmpu_surface_evaluate_grid, gmpu_grid_polygonize, gmpu_mesh_grid_keys). */
 #define GMPU_VERSION_MAJOR 0
 #define GMPU_VERSION_MINOR 4
 #define GMPU_VERSION_PATCH 0
@@ -496,6 +497,50 @@ GMPU_API const uint8_t *gmpu_points_colors(const gmpu_points *points);
 /* Writes points (and normals, if any): .ply (binary little-endian) or .xyz (ascii).
  * Atomic like gmpu_mesh_write. Errors: INVALID_ARGUMENT, UNSUPPORTED, IO. */
 GMPU_API gmpu_status gmpu_points_write(const gmpu_points *points, const char *path);
+
+/* ---- tiles: one surface reconstructed piecewise on a shared grid ------------------------
+ *
+ * For clouds too large for one process (bindings/python/gmpu/dask.py): the domain is cut
+ * into tiles, each reconstructed by its own surface from its points and an overlap margin;
+ * all tiles share one global grid — cubes of side cell_size from grid_origin (caller's
+ * units), grid_cells[3] cubes along x, y, z (multiples of 8), cut in blocks of 8³ cubes;
+ * block (bx, by, bz) spans lattice corners 8·bx .. 8·bx + 8 along x, and so on. Each block
+ * is owned by one tile, and a block owns the corners 8·b .. 8·b + 7 (half-open), so every
+ * corner has one owner and one value: marching a block also needs the first corner layer
+ * of its +x, +y, +z neighbours, which the caller exchanges between tiles. Vertices are
+ * named by their lattice edge, so the tiles' meshes weld into one closed mesh. */
+
+/* f (as gmpu_surface_evaluate) at the corners each block owns: for block n of blocks
+ * (3 int64 block coordinates each), values[512·n + i + 8·(j + 8·k)] is f at corner
+ * (8·bx + i, 8·by + j, 8·bz + k), i, j, k in 0..7, located at grid_origin + cell_size ·
+ * corner (the same arithmetic as gmpu_grid_polygonize's vertices). Runs on
+ * GMPU_PARAM_THREADS threads. Errors: INVALID_ARGUMENT (NULL, cell_size not finite and
+ * positive, a non-finite origin, block_count × 512 doubles beyond memory), WRONG_ORDER (not
+ * oriented). */
+GMPU_API gmpu_status gmpu_surface_evaluate_grid(const gmpu_surface *surface, const double *grid_origin,
+                                                double cell_size, const int64_t *blocks, size_t block_count,
+                                                double *values);
+
+/* Marching tetrahedra (the Kuhn split gmpu_surface_polygonize uses) over the given blocks
+ * of the global grid, with the caller's corner values: corner_values[729·n + i + 9·(j + 9·k)]
+ * for block n at corner (8·bx + i, 8·by + j, 8·bz + k), i, j, k in 0..8, positive inside.
+ * Two calls that give the same value to a shared corner cut the shared face identically.
+ * *out gets the triangles (counter-clockwise seen from outside, where f < 0) with one vertex
+ * per lattice edge among the given blocks, at grid_origin + cell_size · (linear
+ * interpolation of the edge's corners); the mesh has no normals and no confidence, and
+ * gmpu_mesh_grid_keys gives each vertex's edge, for welding the tiles' meshes. An empty
+ * mesh when no block holds a sign change. Errors: INVALID_ARGUMENT (NULL with a non-zero
+ * count, cell_size not finite and positive, grid_cells not positive multiples of 8, a block
+ * outside the grid), INVALID_INPUT (a NaN corner value), OUT_OF_MEMORY. */
+GMPU_API gmpu_status gmpu_grid_polygonize(const double *grid_origin, double cell_size, const int64_t *grid_cells,
+                                          const int64_t *blocks, size_t block_count, const double *corner_values,
+                                          gmpu_mesh **out);
+
+/* Per vertex of a mesh made by gmpu_grid_polygonize: its lattice edge, (x + (cx + 1)·(y +
+ * (cy + 1)·z))·8 + d for its lower corner (x, y, z), grid_cells (cx, cy, cz) and the edge's
+ * direction d (0..6: the corner-offset bits xyz, minus one). Equal keys from two tiles are one
+ * vertex. NULL for any other mesh. */
+GMPU_API const uint64_t *gmpu_mesh_grid_keys(const gmpu_mesh *mesh);
 
 #ifdef __cplusplus
 }

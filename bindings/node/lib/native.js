@@ -130,6 +130,11 @@ function declare(lib) {
         mesh_confidence: f('void *', 'gmpu_mesh_confidence', ['void *']),
         mesh_simplify: f('int', 'gmpu_mesh_simplify', ['void *', 'size_t', 'double', outPtr]),
         mesh_trim: f('int', 'gmpu_mesh_trim', ['void *', 'double', outPtr]),
+        surface_evaluate_grid: f('int', 'gmpu_surface_evaluate_grid',
+            ['void *', 'double *', 'double', 'int64_t *', 'size_t', 'void *']),
+        grid_polygonize: f('int', 'gmpu_grid_polygonize',
+            ['double *', 'double', 'int64_t *', 'int64_t *', 'size_t', 'double *', outPtr]),
+        mesh_grid_keys: f('void *', 'gmpu_mesh_grid_keys', ['void *']),
 
         points_read: f('int', 'gmpu_points_read', ['const char *', outPtr]),
         points_read_with: f('int', 'gmpu_points_read_with',

@@ -154,7 +154,9 @@ def _params(func) -> list:
 def generate_summary(cdef: str) -> str:
     """The ABI summary (see the module's doc) of a cdef."""
     from pycparser import CParser, c_ast
-    prelude = "typedef unsigned long size_t; typedef unsigned int uint32_t; typedef unsigned char uint8_t;\n"
+    prelude_types = ("unsigned long size_t", "unsigned int uint32_t", "long int64_t", "unsigned long uint64_t",
+                     "unsigned char uint8_t")
+    prelude = "".join(f"typedef {t}; " for t in prelude_types) + "\n"
     lines, body = [], []
     for line in cdef.splitlines():
         m = re.match(r"#define (\w+) (\d+)$", line)
@@ -163,7 +165,7 @@ def generate_summary(cdef: str) -> str:
         else:
             body.append(line)
     ast = CParser().parse(prelude + "\n".join(body), "gmpu.h")
-    for node in ast.ext[prelude.count("typedef"):]:
+    for node in ast.ext[len(prelude_types):]:
         t = node.type
         if isinstance(node, c_ast.Typedef) and isinstance(t, c_ast.TypeDecl) and isinstance(t.type, c_ast.Enum):
             value = 0

@@ -252,6 +252,12 @@ c_functions! {
                               out: *mut *mut gmpu_mesh) -> gmpu_status;
     pub fn gmpu_mesh_trim(mesh: *const gmpu_mesh, threshold: f64, out: *mut *mut gmpu_mesh) -> gmpu_status;
 
+    pub fn gmpu_surface_evaluate_grid(surface: *const gmpu_surface, grid_origin: *const f64, cell_size: f64,
+        blocks: *const i64, block_count: usize, values: *mut f64) -> gmpu_status;
+    pub fn gmpu_grid_polygonize(grid_origin: *const f64, cell_size: f64, grid_cells: *const i64, blocks: *const i64,
+        block_count: usize, corner_values: *const f64, out: *mut *mut gmpu_mesh) -> gmpu_status;
+    pub fn gmpu_mesh_grid_keys(mesh: *const gmpu_mesh) -> *const u64;
+
     pub fn gmpu_points_read(path: *const c_char, out: *mut *mut gmpu_points) -> gmpu_status;
     pub fn gmpu_points_read_with(
         path: *const c_char,

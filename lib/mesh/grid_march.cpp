@@ -1,0 +1,59 @@
+#include "mesh/grid_march.hpp"
+
+#include <algorithm>
+#include <unordered_map>
+
+#include "mesh/marching_tetrahedra.hpp"
+
+namespace gmpu {
+
+Mesh march_grid_blocks(const GlobalGrid &grid, const int64_t *blocks, size_t block_count, const double *corner_values,
+                       std::vector<uint64_t> &edge_keys) {
+    constexpr int B = GlobalGrid::kGridBlock, C = B + 1;
+    Mesh mesh;
+    edge_keys.clear();
+    // One vertex per lattice edge across all the given blocks.
+    std::unordered_map<uint64_t, uint32_t> vertex_of;
+    for (size_t b = 0; b < block_count; ++b) {
+        const int64_t x0 = blocks[3 * b] * B, y0 = blocks[3 * b + 1] * B, z0 = blocks[3 * b + 2] * B;
+        const double *value = corner_values + b * size_t(C * C * C);
+        auto local = [](int i, int j, int k) { return size_t(i + C * (j + C * k)); };
+        auto vertex = [&](int i, int j, int k, const mt::Edge &e) -> uint32_t {
+            const int ai = i + (e.from & 1), aj = j + (e.from >> 1 & 1), ak = k + (e.from >> 2 & 1);
+            const int bi = i + (e.to & 1), bj = j + (e.to >> 1 & 1), bk = k + (e.to >> 2 & 1);
+            const uint64_t key = grid.corner_id(x0 + ai, y0 + aj, z0 + ak) * 8 + uint64_t(mt::edge_direction(e));
+            auto found = vertex_of.find(key);
+            if (found != vertex_of.end()) return found->second;
+            const double va = value[local(ai, aj, ak)], vb = value[local(bi, bj, bk)];
+            const double t = std::clamp(va / (va - vb), 0.0, 1.0);
+            const int64_t a[3] = {x0 + ai, y0 + aj, z0 + ak}, c[3] = {x0 + bi, y0 + bj, z0 + bk};
+            for (int d = 0; d < 3; ++d) {
+                const double pa = grid.coordinate(d, a[d]), pb = grid.coordinate(d, c[d]);
+                mesh.vertices.push_back(pa + t * (pb - pa));
+            }
+            const uint32_t id = uint32_t(edge_keys.size());
+            edge_keys.push_back(key);
+            vertex_of.emplace(key, id);
+            return id;
+        };
+        for (int k = 0; k < B; ++k)
+            for (int j = 0; j < B; ++j)
+                for (int i = 0; i < B; ++i) {
+                    int mask8 = 0;
+                    for (int c = 0; c < 8; ++c)
+                        if (value[local(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1))] > 0) mask8 |= 1 << c;
+                    if (mask8 == 0 || mask8 == 255) continue;
+                    for (int t = 0; t < mt::kTetrahedra; ++t) {
+                        int mask = 0;
+                        for (int q = 0; q < 4; ++q)
+                            if (mask8 >> mt::kTetCorners[t][q] & 1) mask |= 1 << q;
+                        const mt::TetCase &tc = mt::tet_case(t, mask);
+                        for (int tri = 0; tri < tc.triangle_count; ++tri)
+                            for (int v = 0; v < 3; ++v) mesh.triangles.push_back(vertex(i, j, k, tc.triangles[tri][v]));
+                    }
+                }
+    }
+    return mesh;
+}
+
+}  // namespace gmpu

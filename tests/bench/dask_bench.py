@@ -1,0 +1,213 @@
+#!/usr/bin/env python3
+"""Tiled reconstruction on Dask against the one-process C path (issue 17), on a bunny cloud
+of --points points sampled by this script (area-uniform on tests/data/meshes/bunny00.off,
+seed 17, float32 binary PLY so that the tiles memory-map it):
+
+- untiled: the CLI (build/examples/gmpu-reconstruct) under /usr/bin/time: wall, peak RSS;
+- tiled: gmpu.dask.reconstruct on a LocalCluster of 2 worker processes (1 thread each) at
+  the untiled run's grid resolution: wall, peak RSS of each worker and of the driver;
+- seams: boundary and non-manifold edges of the tiled mesh; Chamfer (mean nearest-vertex
+  distance, both ways) to the untiled mesh as a share of the diagonal; orientation: the
+  share of tiled vertices whose normal agrees with the nearest untiled vertex's.
+
+    /usr/bin/python3 tests/bench/dask_bench.py --build build --out bench-results/dask [--points 10000000]
+
+Prints one table row per run and writes OUT/dask.json.
+"""
+import argparse
+import json
+import os
+import resource
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+REPO = Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(REPO / "bindings" / "python"))
+
+
+def read_off(path):
+    words = Path(path).read_text().split()
+    nv, nf = int(words[1]), int(words[2])
+    v = np.array(words[4:4 + 3 * nv], float).reshape(nv, 3)
+    f = np.array(words[4 + 3 * nv:4 + 3 * nv + 4 * nf], np.int64).reshape(nf, 4)[:, 1:]
+    return v, f
+
+
+def write_cloud(path, n, seed=17):
+    v, f = read_off(REPO / "tests" / "data" / "meshes" / "bunny00.off")
+    rng = np.random.default_rng(seed)
+    a, b, c = (v[f[:, k]] for k in range(3))
+    area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
+    with open(path, "wb") as out:
+        out.write(f"ply\nformat binary_little_endian 1.0\nelement vertex {n}\nproperty float x\n"
+                  f"property float y\nproperty float z\nend_header\n".encode())
+        for start in range(0, n, 1 << 21):
+            m = min(1 << 21, n - start)
+            tri = rng.choice(len(f), m, p=area / area.sum())
+            s, t = rng.random(m), rng.random(m)
+            flip = s + t > 1
+            s[flip], t[flip] = 1 - s[flip], 1 - t[flip]
+            p = a[tri] + s[:, None] * (b[tri] - a[tri]) + t[:, None] * (c[tri] - a[tri])
+            out.write(p.astype("<f4").tobytes())
+
+
+def read_mesh_ply(path):
+    """Vertices and triangles of a binary little-endian PLY the CLI wrote."""
+    with open(path, "rb") as f:
+        props, nv, nf, element = [], 0, 0, None
+        while True:
+            words = f.readline().decode().split()
+            if words[0] == "element":
+                element = words[1]
+                if element == "vertex":
+                    nv = int(words[2])
+                else:
+                    nf = int(words[2])
+            elif words[0] == "property" and element == "vertex":
+                props.append((words[2], {"float": "<f4", "double": "<f8"}[words[1]]))
+            elif words[0] == "end_header":
+                break
+        vert = np.frombuffer(f.read(nv * np.dtype(props).itemsize), np.dtype(props), nv)
+        faces = np.frombuffer(f.read(nf * 13), np.dtype([("n", "u1"), ("i", "<i4", 3)]), nf)
+    xyz = np.stack([vert["x"], vert["y"], vert["z"]], axis=1).astype(np.float64)
+    normals = np.stack([vert["nx"], vert["ny"], vert["nz"]], axis=1) if "nx" in vert.dtype.names else None
+    return xyz, faces["i"].astype(np.int64), normals
+
+
+def edge_problems(faces):
+    f = faces.astype(np.int64)
+    e = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    key = e[:, 0] * (int(f.max()) + 1) + e[:, 1]
+    _, counts = np.unique(key, return_counts=True)
+    return int((counts == 1).sum()), int((counts > 2).sum())
+
+
+def compare(tiled_v, tiled_n, untiled_v, untiled_n, samples=300_000, seed=1):
+    from scipy.spatial import cKDTree
+    rng = np.random.default_rng(seed)
+    a = rng.choice(len(tiled_v), min(samples, len(tiled_v)), replace=False)
+    b = rng.choice(len(untiled_v), min(samples, len(untiled_v)), replace=False)
+    da, ia = cKDTree(untiled_v).query(tiled_v[a])
+    db, _ = cKDTree(tiled_v).query(untiled_v[b])
+    agree = np.einsum("ij,ij->i", tiled_n[a], untiled_n[ia]) > 0
+    return 0.5 * (da.mean() + db.mean()), float(agree.mean())
+
+
+def untiled_run(build, cloud, out):
+    cli = Path(build) / "examples" / "gmpu-reconstruct"
+    t = time.perf_counter()
+    r = subprocess.run(["/usr/bin/time", "-f", "PEAK_KB %M", str(cli), str(cloud), "-o", str(out)],
+                       capture_output=True, text=True, check=True)
+    wall = time.perf_counter() - t
+    peak = int(next(line.split()[1] for line in r.stderr.splitlines() if line.startswith("PEAK_KB")))
+    resolution = int(r.stderr.split("at resolution ")[1].split()[0])
+    return wall, peak * 1024, resolution
+
+
+def tiled_run(cloud, resolution, tile_points, workers):
+    from distributed import Client, LocalCluster
+    import gmpu.dask as gd
+    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                           memory_limit=0)
+    client = Client(cluster)
+    try:
+        stats = {}
+        t = time.perf_counter()
+        mesh = gd.reconstruct(str(cloud), client, tile_points=tile_points, resolution=resolution, stats=stats,
+                              threads=1)
+        wall = time.perf_counter() - t
+        peaks = client.run(lambda: resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024)
+    finally:
+        client.close()
+        cluster.close()
+    driver = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+    return mesh, wall, sorted(peaks.values()), driver, stats
+
+
+def kill_check(cloud, resolution, tile_points, workers):
+    """Fault tolerance: the tiled run again, with one worker process killed (SIGKILL) part way
+    through its first phase; the nanny restarts it, Dask recomputes what it held, and the mesh
+    must be identical to an undisturbed run's."""
+    import signal
+    import threading
+    from distributed import Client, LocalCluster
+    import gmpu.dask as gd
+    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                           memory_limit=0)
+    client = Client(cluster)
+    try:
+        stats = {}
+        t = time.perf_counter()
+        clean = gd.reconstruct(str(cloud), client, tile_points=tile_points, resolution=resolution, stats=stats,
+                               threads=1)
+        first_phase = stats["phase1_seconds"]
+        pid = sorted(client.run(os.getpid).values())[0]
+        killer = threading.Timer(0.5 * first_phase, lambda: os.kill(pid, signal.SIGKILL))
+        killer.start()
+        disturbed = gd.reconstruct(str(cloud), client, tile_points=tile_points, resolution=resolution, threads=1)
+        killer.join()
+        restarted = pid not in client.run(os.getpid).values()
+    finally:
+        client.close()
+        cluster.close()
+    same = (np.array_equal(np.asarray(clean.vertices), np.asarray(disturbed.vertices)) and
+            np.array_equal(np.asarray(clean.faces), np.asarray(disturbed.faces)))
+    return same, restarted, time.perf_counter() - t
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--build", default="build")
+    ap.add_argument("--out", default="bench-results/dask")
+    ap.add_argument("--points", type=int, default=10_000_000)
+    ap.add_argument("--tile-points", type=int, default=1_000_000)
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--kill-check", type=int, default=0,
+                    help="points of a cloud on which a worker is killed mid-run (0: no check)")
+    args = ap.parse_args()
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    cloud = out / f"bunny_{args.points}.ply"
+    if not cloud.exists():
+        # In a child process, so that this one's peak memory is the driver's alone.
+        subprocess.run([sys.executable, "-c", f"import sys; sys.path.insert(0, {str(Path(__file__).parent)!r}); "
+                        f"import dask_bench; dask_bench.write_cloud({str(cloud)!r}, {args.points})"], check=True)
+    untiled_mesh = out / "untiled.ply"
+    u_wall, u_peak, resolution = untiled_run(args.build, cloud, untiled_mesh)
+    print(f"untiled: {u_wall:.1f} s wall, {u_peak / 1e9:.2f} GB peak, resolution {resolution}", flush=True)
+    mesh, t_wall, peaks, driver, stats = tiled_run(cloud, resolution, args.tile_points, args.workers)
+    boundary, nonmanifold = edge_problems(np.asarray(mesh.faces))
+    uv, uf, un = read_mesh_ply(untiled_mesh)
+    diagonal = float(np.linalg.norm(uv.max(0) - uv.min(0)))
+    cham, agree = compare(np.asarray(mesh.vertices), np.asarray(mesh.normals), uv, un)
+    row = {
+        "points": args.points, "tiles": stats["tiles"], "tile_points": args.tile_points, "workers": args.workers,
+        "untiled_seconds": round(u_wall, 2), "untiled_peak_bytes": u_peak,
+        "tiled_seconds": round(t_wall, 2), "worker_peak_bytes": peaks, "driver_peak_bytes": driver,
+        "boundary_edges": boundary, "nonmanifold_edges": nonmanifold, "components": mesh.components,
+        "genus": mesh.genus, "chamfer_share_of_diagonal": cham / diagonal, "orientation_agreement": agree,
+        "tiled_volume_positive": bool(mesh.volume > 0), "resolution": resolution,
+        "phase1_seconds": round(stats["phase1_seconds"], 2),
+    }
+    print(f"tiled:   {t_wall:.1f} s wall, workers {[round(p / 1e9, 2) for p in peaks]} GB peak, driver "
+          f"{driver / 1e9:.2f} GB; {stats['tiles']} tiles; boundary {boundary}, non-manifold {nonmanifold}, "
+          f"components {mesh.components}, genus {mesh.genus}; Chamfer {100 * cham / diagonal:.4f} % of the diagonal; "
+          f"orientation agreement {100 * agree:.3f} %", flush=True)
+    if args.kill_check:
+        small = out / f"bunny_{args.kill_check}.ply"
+        if not small.exists():
+            write_cloud(small, args.kill_check)
+        same, restarted, seconds = kill_check(small, resolution, max(args.kill_check // 4, 1), args.workers)
+        row.update(kill_check_points=args.kill_check, kill_check_identical=same, kill_check_worker_restarted=restarted)
+        print(f"killed a worker mid-run on {args.kill_check} points: worker restarted {restarted}, mesh identical "
+              f"{same} ({seconds:.0f} s for both runs)", flush=True)
+    (out / "dask.json").write_text(json.dumps(row, indent=1))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

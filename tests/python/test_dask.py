@@ -1,0 +1,182 @@
+"""gmpu.dask: tiled reconstruction on a 2-worker LocalCluster (threads in one process:
+processes=False, so the suite starts in a second), tiles forced small so that a 50k-point
+bunny spans 8 tiles. The welded mesh must be closed and manifold, one piece, of the untiled
+mesh's genus, close to it (Chamfer) and outward; a tile whose surface comes out reversed is
+put right by the tiles' sign reconciliation and breaks the mesh without it."""
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+import gmpu
+from conftest import BINDINGS, PYTHON
+
+distributed = pytest.importorskip("distributed")
+scipy_spatial = pytest.importorskip("scipy.spatial")
+import gmpu.dask as gd  # noqa: E402
+
+TILE_POINTS = 7000  # 50k points → 8 tiles
+
+
+def read_off(path):
+    with open(path) as f:
+        words = f.read().split()
+    assert words[0] == "OFF"
+    nv, nf = int(words[1]), int(words[2])
+    v = np.array(words[4:4 + 3 * nv], float).reshape(nv, 3)
+    rest = np.array(words[4 + 3 * nv:4 + 3 * nv + 4 * nf], np.int64).reshape(nf, 4)
+    return v, rest[:, 1:]
+
+
+def sample_surface(vertices, faces, n, seed):
+    """n points uniformly on the triangles (area-weighted), reproducibly."""
+    rng = np.random.default_rng(seed)
+    a, b, c = (vertices[faces[:, k]] for k in range(3))
+    area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
+    tri = rng.choice(len(faces), n, p=area / area.sum())
+    u, v = rng.random(n), rng.random(n)
+    flip = u + v > 1
+    u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
+    return a[tri] + u[:, None] * (b[tri] - a[tri]) + v[:, None] * (c[tri] - a[tri])
+
+
+def edge_problems(faces):
+    """(boundary edges, non-manifold edges) of a triangle mesh."""
+    f = faces.astype(np.int64)
+    e = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    _, counts = np.unique(e, axis=0, return_counts=True)
+    return int((counts == 1).sum()), int((counts > 2).sum())
+
+
+def components_and_genus(faces, vertex_count):
+    """Connected pieces and the genus of a closed mesh (Euler: V − E + F = 2(C − g))."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    f = faces.astype(np.int64)
+    graph = coo_matrix((np.ones(2 * len(f)), (np.concatenate([f[:, 0], f[:, 1]]), np.concatenate([f[:, 1], f[:, 2]]))),
+                       shape=(vertex_count, vertex_count))
+    used = np.unique(f)
+    n, label = connected_components(graph, directed=False)
+    pieces = len(np.unique(label[used]))
+    e = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    edges = len(np.unique(e[:, 0] * vertex_count + e[:, 1]))
+    chi = len(used) - edges + len(f)
+    return pieces, (2 * pieces - chi) // 2
+
+
+def chamfer(a, b):
+    """Mean of the two one-sided mean nearest-vertex distances."""
+    da, _ = scipy_spatial.cKDTree(b).query(a)
+    db, _ = scipy_spatial.cKDTree(a).query(b)
+    return 0.5 * (da.mean() + db.mean())
+
+
+@pytest.fixture(scope="module")
+def cloud(data_dir):
+    v, f = read_off(data_dir / "meshes" / "bunny00.off")
+    return sample_surface(v, f, 50_000, seed=17)
+
+
+@pytest.fixture(scope="module")
+def untiled(cloud):
+    with gmpu.Surface(cloud) as s:
+        s.fit()
+        s.orient()
+        mesh = s.polygonize()
+        return mesh, int(s.stats["resolution"])
+
+
+@pytest.fixture(scope="module")
+def client():
+    from distributed import Client, LocalCluster
+    cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=False, dashboard_address=None)
+    c = Client(cluster)
+    yield c
+    c.close()
+    cluster.close()
+
+
+@pytest.fixture(scope="module")
+def tiled(cloud, untiled, client):
+    stats = {}
+    mesh = gd.reconstruct(cloud, client, tile_points=TILE_POINTS, resolution=untiled[1], stats=stats, threads=1)
+    return mesh, stats
+
+
+def test_the_cloud_spans_eight_tiles(tiled):
+    assert tiled[1]["tiles"] == 8
+    assert all(n > 0 for n in tiled[1]["tile_points"])
+
+
+def test_the_union_is_closed_and_manifold(tiled):
+    assert edge_problems(tiled[0].faces) == (0, 0)
+
+
+def test_topology_is_the_untiled_one(tiled, untiled):
+    pieces, genus = components_and_genus(tiled[0].faces, len(tiled[0].vertices))
+    assert (pieces, genus) == components_and_genus(untiled[0].faces, len(untiled[0].vertices))
+    assert pieces == 1
+
+
+def test_close_to_the_untiled_mesh_and_outward(tiled, untiled, cloud):
+    diagonal = np.linalg.norm(cloud.max(0) - cloud.min(0))
+    assert chamfer(tiled[0].vertices, untiled[0].vertices) < 2e-3 * diagonal
+    assert tiled[0].volume > 0
+    assert abs(tiled[0].volume / untiled[0].volume - 1) < 0.01
+
+
+def test_a_reversed_tile_is_reconciled(cloud, untiled, client):
+    """Tile 3's surface turned over (as an open patch's orientation may come out): the
+    reconciliation flips it back; without it the mesh is wrong."""
+    mesh = gd.reconstruct(cloud, client, tile_points=TILE_POINTS, resolution=untiled[1], threads=1,
+                          _flip_tiles=[3])
+    assert edge_problems(mesh.faces) == (0, 0)
+    assert components_and_genus(mesh.faces, len(mesh.vertices)) == \
+        components_and_genus(untiled[0].faces, len(untiled[0].vertices))
+    assert mesh.volume > 0
+    assert abs(mesh.volume / untiled[0].volume - 1) < 0.01
+    # Marching tetrahedra closes any consistent set of corner values, so the reversed tile
+    # does not open the mesh: it turns its part inside out, with handles where it meets
+    # the other tiles.
+    broken = gd.reconstruct(cloud, client, tile_points=TILE_POINTS, resolution=untiled[1], threads=1,
+                            _flip_tiles=[3], reconcile=False)
+    assert components_and_genus(broken.faces, len(broken.vertices))[1] != \
+        components_and_genus(untiled[0].faces, len(untiled[0].vertices))[1] or \
+        abs(broken.volume / untiled[0].volume - 1) > 0.01
+
+
+def test_plan_splits_on_block_boundaries(cloud):
+    lo, hi = cloud.min(0), cloud.max(0)
+    plan = gd.plan_tiles(cloud, len(cloud), lo, hi, tile_points=TILE_POINTS, resolution=128)
+    assert len(plan.tiles) == 8
+    owned = np.zeros(tuple(plan.grid.blocks[::-1]), int)
+    for bl, bh in plan.tiles:
+        owned[bl[2]:bh[2], bl[1]:bh[1], bl[0]:bh[0]] += 1
+    assert (owned == 1).all()  # every block has exactly one owner
+
+
+def test_cli_on_a_memory_mapped_ply(tmp_path, data_dir):
+    """The command line, on a binary PLY the tiles memory-map (worker threads: processes
+    take tens of seconds to start on a loaded machine; the bench runs processes)."""
+    out = tmp_path / "bunny.ply"
+    env = {"PYTHONPATH": str(BINDINGS)}
+    import os
+    env.update({k: v for k, v in os.environ.items() if k not in env})
+    r = subprocess.run([PYTHON, "-m", "gmpu.dask", str(data_dir / "clouds" / "bunny_clean.ply"), "-o", str(out),
+                        "--local-workers", "2", "--in-process", "--tile-points", "10000"], env=env, capture_output=True, text=True,
+                       timeout=300)
+    assert r.returncode == 0, r.stderr
+    mesh = gmpu.read_points(out)  # the vertices, at least
+    assert len(mesh) > 1000
+    assert "tiles" in r.stdout
+
+
+def test_every_tile_reversed_is_turned_outward(cloud, untiled, client):
+    """All tiles turned over agree with each other, so only the outward pass (the band next
+    to the grid's outer far region must be outside) can put them right."""
+    mesh = gd.reconstruct(cloud, client, tile_points=TILE_POINTS, resolution=untiled[1], threads=1,
+                          _flip_tiles=range(8))
+    assert mesh.volume > 0
+    assert components_and_genus(mesh.faces, len(mesh.vertices)) == \
+        components_and_genus(untiled[0].faces, len(untiled[0].vertices))
