@@ -36,22 +36,9 @@ Mesh march_grid_blocks(const GlobalGrid &grid, const int64_t *blocks, size_t blo
             vertex_of.emplace(key, id);
             return id;
         };
-        for (int k = 0; k < B; ++k)
-            for (int j = 0; j < B; ++j)
-                for (int i = 0; i < B; ++i) {
-                    int mask8 = 0;
-                    for (int c = 0; c < 8; ++c)
-                        if (value[local(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1))] > 0) mask8 |= 1 << c;
-                    if (mask8 == 0 || mask8 == 255) continue;
-                    for (int t = 0; t < mt::kTetrahedra; ++t) {
-                        int mask = 0;
-                        for (int q = 0; q < 4; ++q)
-                            if (mask8 >> mt::kTetCorners[t][q] & 1) mask |= 1 << q;
-                        const mt::TetCase &tc = mt::tet_case(t, mask);
-                        for (int tri = 0; tri < tc.triangle_count; ++tri)
-                            for (int v = 0; v < 3; ++v) mesh.triangles.push_back(vertex(i, j, k, tc.triangles[tri][v]));
-                    }
-                }
+        mt::march_block(
+            B, [&](int i, int j, int k) { return value[local(i, j, k)]; },
+            [&](int i, int j, int k, const mt::Edge &e) { mesh.triangles.push_back(vertex(i, j, k, e)); });
     }
     return mesh;
 }

@@ -32,4 +32,28 @@ const TetCase &tet_case(int tet, int inside_mask);
 // bit pattern xyz, minus one.
 inline int edge_direction(const Edge &e) { return (e.to ^ e.from) - 1; }
 
+// Marches the n³ cubes of a block whose corner values value(i, j, k) are given for i, j, k in
+// 0..n: for each corner of each triangle, in order, emit(i, j, k, edge) names the cube and
+// the cube edge its vertex lies on. The one-process polygonizer and the tiles' march share
+// it, so both cut the same triangles from the same values.
+template <class Value, class Emit>
+void march_block(int n, const Value &value, Emit &&emit) {
+    for (int k = 0; k < n; ++k)
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i) {
+                int mask8 = 0;
+                for (int c = 0; c < 8; ++c)
+                    if (value(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1)) > 0) mask8 |= 1 << c;
+                if (mask8 == 0 || mask8 == 255) continue;
+                for (int t = 0; t < kTetrahedra; ++t) {
+                    int mask = 0;
+                    for (int q = 0; q < 4; ++q)
+                        if (mask8 >> kTetCorners[t][q] & 1) mask |= 1 << q;
+                    const TetCase &tc = tet_case(t, mask);
+                    for (int tri = 0; tri < tc.triangle_count; ++tri)
+                        for (int v = 0; v < 3; ++v) emit(i, j, k, tc.triangles[tri][v]);
+                }
+            }
+}
+
 }  // namespace gmpu::mt

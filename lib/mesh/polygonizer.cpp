@@ -166,22 +166,9 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuck
         return uint32_t(s);
     };
 
-    for (int k = 0; k < B; ++k)
-        for (int j = 0; j < B; ++j)
-            for (int i = 0; i < B; ++i) {
-                int mask8 = 0;
-                for (int c = 0; c < 8; ++c)
-                    if (value[size_t(local(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1)))] > 0) mask8 |= 1 << c;
-                if (mask8 == 0 || mask8 == 255) continue;
-                for (int t = 0; t < mt::kTetrahedra; ++t) {
-                    int mask = 0;
-                    for (int q = 0; q < 4; ++q)
-                        if (mask8 >> mt::kTetCorners[t][q] & 1) mask |= 1 << q;
-                    const mt::TetCase &tc = mt::tet_case(t, mask);
-                    for (int tri = 0; tri < tc.triangle_count; ++tri)
-                        for (int v = 0; v < 3; ++v) out.triangles.push_back(vertex(i, j, k, tc.triangles[tri][v]));
-                }
-            }
+    mt::march_block(
+        B, [&](int i, int j, int k) { return value[size_t(local(i, j, k))]; },
+        [&](int i, int j, int k, const mt::Edge &e) { out.triangles.push_back(vertex(i, j, k, e)); });
 
     // Each point inside the block votes for its nearest vertex here: the surface near the
     // data collects the votes, bubbles away from it none (see remove_unsupported_components).

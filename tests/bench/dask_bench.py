@@ -15,6 +15,7 @@ seed 17, float32 binary PLY so that the tiles memory-map it):
 Prints one table row per run and writes OUT/dask.json.
 """
 import argparse
+import contextlib
 import json
 import os
 import resource
@@ -108,22 +109,29 @@ def untiled_run(build, cloud, out):
     return wall, peak * 1024, resolution
 
 
-def tiled_run(cloud, resolution, tile_points, workers):
+@contextlib.contextmanager
+def local_client(workers):
+    """A client of a LocalCluster of `workers` single-threaded worker processes, closed after."""
     from distributed import Client, LocalCluster
-    import gmpu.dask as gd
     cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
                            memory_limit=0)
     client = Client(cluster)
     try:
+        yield client
+    finally:
+        client.close()
+        cluster.close()
+
+
+def tiled_run(cloud, resolution, tile_points, workers):
+    import gmpu.dask as gd
+    with local_client(workers) as client:
         stats = {}
         t = time.perf_counter()
         mesh = gd.reconstruct(str(cloud), client, tile_points=tile_points, resolution=resolution, stats=stats,
                               threads=1)
         wall = time.perf_counter() - t
         peaks = client.run(lambda: resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024)
-    finally:
-        client.close()
-        cluster.close()
     driver = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
     return mesh, wall, sorted(peaks.values()), driver, stats
 
@@ -134,12 +142,8 @@ def kill_check(cloud, resolution, tile_points, workers):
     must be identical to an undisturbed run's."""
     import signal
     import threading
-    from distributed import Client, LocalCluster
     import gmpu.dask as gd
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
-                           memory_limit=0)
-    client = Client(cluster)
-    try:
+    with local_client(workers) as client:
         stats = {}
         t = time.perf_counter()
         clean = gd.reconstruct(str(cloud), client, tile_points=tile_points, resolution=resolution, stats=stats,
@@ -151,9 +155,6 @@ def kill_check(cloud, resolution, tile_points, workers):
         disturbed = gd.reconstruct(str(cloud), client, tile_points=tile_points, resolution=resolution, threads=1)
         killer.join()
         restarted = pid not in client.run(os.getpid).values()
-    finally:
-        client.close()
-        cluster.close()
     same = (np.array_equal(np.asarray(clean.vertices), np.asarray(disturbed.vertices)) and
             np.array_equal(np.asarray(clean.faces), np.asarray(disturbed.faces)))
     return same, restarted, time.perf_counter() - t
