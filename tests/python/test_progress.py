@@ -138,6 +138,9 @@ CTRL_C_CHILD = r"""
 import json, os, signal, sys, threading, time, traceback
 import gmpu
 
+# Python's own Ctrl-C handler, whatever the disposition inherited: a job started in the
+# background (nohup make test &) inherits SIGINT ignored, and Python then installs none.
+signal.signal(signal.SIGINT, signal.default_int_handler)
 mode = sys.argv[1]
 pts = gmpu.read_points(sys.argv[2])
 s = gmpu.Surface(pts).fit().orient()
