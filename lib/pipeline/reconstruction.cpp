@@ -83,16 +83,13 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
 Mesh Reconstruction::polygonize(const Params &params, int resolution, Progress &progress) {
     Workers &pool = workers(params.threads);
     progress.report(0.0, true);
-    if (wants_smooth_surface(params, points, noise) != bool(smooth)) {
-        Progress smooth_progress = progress.slice(0.0, 0.3);
-        smooth = wants_smooth_surface(params, points, noise)
-                     ? solve_smooth_surface(params, tree, points, measures, noise, smooth_progress)
-                     : nullptr;
-        Progress rest = progress.slice(0.3, 1.0);
-        return gmpu::polygonize(field(params.level), resolution, params, pool, rest, noise);
-    }
-    Mesh mesh = gmpu::polygonize(field(params.level), resolution, params, pool, progress, noise);
-    return mesh;  // the caller checks it and makes the final report
+    // The caller checks the mesh and makes the final report.
+    const bool wants_smooth = wants_smooth_surface(params, points, noise);
+    if (wants_smooth == bool(smooth)) return gmpu::polygonize(field(params.level), resolution, params, pool, progress, noise);
+    // The surface parameter changed since orient: solve or drop the smooth field first.
+    Progress solve_progress = progress.slice(0.0, 0.3), march_progress = progress.slice(0.3, 1.0);
+    smooth = wants_smooth ? solve_smooth_surface(params, tree, points, measures, noise, solve_progress) : nullptr;
+    return gmpu::polygonize(field(params.level), resolution, params, pool, march_progress, noise);
 }
 
 int Reconstruction::default_resolution(const Params &params) const {
