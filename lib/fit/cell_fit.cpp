@@ -12,6 +12,18 @@ constexpr size_t kMaxFitPoints = 2048;
 // Sharp features are looked for only in small supports (finest cells): in large ones two
 // clusters of normals mostly mean curvature, not an edge.
 constexpr size_t kMaxSharpSupport = 64;
+// A thin part (a leg, a finger, an ear, a blade) two or three sample spacings across: the
+// smallest supports (N_min points) hold both of its sides, and on noise-free data ε is about
+// one spacing, so a height field through the middle of the part can pass or stay a leaf
+// while it gives both sides one normal. Such supports are far from flat (surface variation
+// above kThinPartVariation, where a patch of a smooth surface reads under 0.02); a general
+// quadric can close around the part, and is taken when its error is under
+// kThinPartImprovement × the height field's. Only where the fit is not noise-limited and its
+// error is at least kThinPartError × ε: elsewhere the general quadric's extra zero sets
+// cost more than they win.
+constexpr double kThinPartVariation = 0.05;
+constexpr double kThinPartImprovement = 0.25;
+constexpr double kThinPartError = 0.25;
 
 const PointList &fit_sample(const PointList &support, PointList &buffer) {
     if (support.size() <= kMaxFitPoints) return support;
@@ -46,6 +58,17 @@ CellFit fit_cell(const PointList &support, double radius, double epsilon, double
         const SheetSplit split = fit_two_sheets(support, fit.shape, fit.error, radius, close_sheets, two);
         if (two.shape.model == Model::two_sheets) return two;
         fit.unresolved_sheets = split.found;
+    }
+    if (epsilon <= requested && fit.shape.model == Model::bivariate && pca.variation > kThinPartVariation &&
+        fit.error > kThinPartError * epsilon) {
+        LocalShape general;
+        general.model = Model::quadric;
+        general.q = fit_general_quadric(sample, radius);
+        const double e = taubin_error(general, no_pieces, support);
+        if (e < kThinPartImprovement * fit.error) {
+            fit.shape = general;
+            fit.error = e;
+        }
     }
 
     if (fit.error > epsilon && params.sharp_features && support.size() <= kMaxSharpSupport) {
