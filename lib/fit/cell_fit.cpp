@@ -18,25 +18,11 @@ constexpr size_t kMaxSharpSupport = 64;
 // while it gives both sides one normal. Such supports are far from flat (surface variation
 // above kThinPartVariation, where a patch of a smooth surface reads under 0.02); a general
 // quadric can close around the part, and is taken when its error is under
-// kThinPartImprovement × the height field's and it stays open along the support's main
-// axis. Only where the fit is not noise-limited and its
-// error is at least kThinPartError × ε: elsewhere the general quadric's extra zero sets
-// cost more than they win.
+// kThinPartImprovement × the height field's. Only where the fit is not noise-limited and its
+// error is at least kThinPartError × ε; elsewhere the paper's choice stands.
 constexpr double kThinPartVariation = 0.05;
 constexpr double kThinPartImprovement = 0.25;
 constexpr double kThinPartError = 0.25;
-
-// Whether the quadric keeps one sign along the support's main axis, through its centroid,
-// across the whole ball: around a thin part it must be a tube or a slab, not a shell that
-// closes inside the support and so cuts the part in two.
-bool open_along_axis(const Quadric &q, const Pca &pca, double radius) {
-    const Eigen::Vector3d axis = pca.axes.col(2);
-    const double centre = q.value(pca.centroid);
-    constexpr int kSteps = 8;
-    for (int k = -kSteps; k <= kSteps; ++k)
-        if (centre * q.value(pca.centroid + (double(k) / kSteps) * radius * axis) <= 0.0) return false;
-    return true;
-}
 
 const PointList &fit_sample(const PointList &support, PointList &buffer) {
     if (support.size() <= kMaxFitPoints) return support;
@@ -78,7 +64,7 @@ CellFit fit_cell(const PointList &support, double radius, double epsilon, double
         general.model = Model::quadric;
         general.q = fit_general_quadric(sample, radius);
         const double e = taubin_error(general, no_pieces, support);
-        if (e < kThinPartImprovement * fit.error && open_along_axis(general.q, pca, radius)) {
+        if (e < kThinPartImprovement * fit.error) {
             fit.shape = general;
             // A cell that missed ε still splits as before, so the octree and the grid the
             // polygonizer sizes from its leaves do not coarsen (a part two spacings across
