@@ -1,5 +1,7 @@
 #include "fit/cell_fit.hpp"
 
+#include <algorithm>
+
 #include "fit/piecewise_fit.hpp"
 #include "fit/two_sheet_fit.hpp"
 
@@ -23,6 +25,18 @@ constexpr size_t kMaxSharpSupport = 64;
 constexpr double kThinPartVariation = 0.05;
 constexpr double kThinPartImprovement = 0.25;
 constexpr double kThinPartError = 0.25;
+// Around a thin part, the quadric's gradients on the support point both ways across it;
+// at a crease or a corner (a far-from-flat support of one side) nearly all point one way,
+// and a general quadric there only adds zero sets. This share of the support must have
+// its gradient on the other side of the support's tangent plane from the rest.
+constexpr double kThinPartOpposed = 0.2;
+
+// Share of the points whose gradient of `q` points against the majority's, along `normal`.
+double opposed_share(const Quadric &q, const PointList &points, const Eigen::Vector3d &normal) {
+    size_t up = 0;
+    for (const auto &p : points) up += q.gradient(p).dot(normal) > 0.0;
+    return double(std::min(up, points.size() - up)) / double(std::max<size_t>(1, points.size()));
+}
 
 const PointList &fit_sample(const PointList &support, PointList &buffer) {
     if (support.size() <= kMaxFitPoints) return support;
@@ -64,7 +78,7 @@ CellFit fit_cell(const PointList &support, double radius, double epsilon, double
         general.model = Model::quadric;
         general.q = fit_general_quadric(sample, radius);
         const double e = taubin_error(general, no_pieces, support);
-        if (e < kThinPartImprovement * fit.error) {
+        if (e < kThinPartImprovement * fit.error && opposed_share(general.q, sample, pca.axes.col(0)) >= kThinPartOpposed) {
             fit.shape = general;
             // A cell that missed ε still splits as before, so the octree and the grid the
             // polygonizer sizes from its leaves do not coarsen (a part two spacings across
