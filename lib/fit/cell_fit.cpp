@@ -30,6 +30,9 @@ constexpr double kThinPartError = 0.25;
 // and a general quadric there only adds zero sets. This share of the support must have
 // its gradient on the other side of the support's tangent plane from the rest.
 constexpr double kThinPartOpposed = 0.2;
+// Thin parts a few spacings across are decided in small supports; a large one that misses
+// ε is split anyway, and refitting it would only cost time.
+constexpr size_t kThinPartMaxSupport = 128;
 
 // Share of the points whose gradient of `q` points against the majority's, along `normal`.
 double opposed_share(const Quadric &q, const PointList &points, const Eigen::Vector3d &normal) {
@@ -72,7 +75,7 @@ CellFit fit_cell(const PointList &support, double radius, double epsilon, double
         if (two.shape.model == Model::two_sheets) return two;
         fit.unresolved_sheets = split.found;
     }
-    if (epsilon <= requested && fit.shape.model == Model::bivariate && pca.variation > kThinPartVariation &&
+    if (epsilon <= requested && support.size() <= kThinPartMaxSupport && fit.shape.model == Model::bivariate && pca.variation > kThinPartVariation &&
         fit.error > kThinPartError * epsilon) {
         LocalShape general;
         general.model = Model::quadric;
