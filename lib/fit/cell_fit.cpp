@@ -75,13 +75,14 @@ CellFit fit_cell(const PointList &support, double radius, double epsilon, double
         if (two.shape.model == Model::two_sheets) return two;
         fit.unresolved_sheets = split.found;
     }
-    if (epsilon <= requested && support.size() <= kThinPartMaxSupport && fit.shape.model == Model::bivariate && pca.variation > kThinPartVariation &&
-        fit.error > kThinPartError * epsilon) {
+    if (epsilon <= requested && support.size() <= kThinPartMaxSupport && fit.shape.model == Model::bivariate &&
+        pca.variation > kThinPartVariation && fit.error > kThinPartError * epsilon) {
         LocalShape general;
         general.model = Model::quadric;
         general.q = fit_general_quadric(sample, radius);
         const double e = taubin_error(general, no_pieces, support);
-        if (e < kThinPartImprovement * fit.error && opposed_share(general.q, sample, pca.axes.col(0)) >= kThinPartOpposed) {
+        if (e < kThinPartImprovement * fit.error &&
+            opposed_share(general.q, sample, pca.axes.col(0)) >= kThinPartOpposed) {
             fit.shape = general;
             // A cell that missed ε still splits as before, so the octree and the grid the
             // polygonizer sizes from its leaves do not coarsen (a part two spacings across
