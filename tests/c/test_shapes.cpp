@@ -153,6 +153,26 @@ void sparse_thin_plate(void **) {
     check_signs(r, shape, {{0, 0, 0}, {0.5, -0.5, 0}, {0, 0, 0.05}, {0, 0, -0.05}});
 }
 
+void thin_torus(void **) {
+    // A tube two sample spacings across (3,000 points, tube radius 0.6 % of the diagonal):
+    // the smallest supports hold both sides of it and, with ε about one spacing, a height
+    // field through the middle of the tube passes; the blend then gives both sides one
+    // normal (orientation about 50 %, genus over 20). A general quadric closes around the
+    // tube where the height field misfits it (cell_fit.cpp).
+    Torus shape({0, 0, 0}, 1.0, 0.012);
+    OrientedPoints pts = shape.sample(3000, 2);
+    Reconstruction r = reconstruct(pts.positions);
+    assert_int_equal(r.status, GMPU_OK);
+    MeshCheck check = check_mesh(r.mesh);
+    const double accuracy = orientation_accuracy(r.normals, pts.normals).accuracy;
+    fprintf(stderr, "  orientation %.2f%%, %zu components, genus %d\n", 100 * accuracy, check.components,
+            check.components ? check.component_reports[0].genus : -1);
+    assert_true(check.watertight);
+    assert_int_equal(check.components, 1);
+    assert_int_equal(check.component_reports[0].genus, 1);
+    assert_true(accuracy >= 0.99);
+}
+
 void cube(void **) {
     // Sharp edges and corners. Beside a corner, coarse cells with no point in their cube
     // fit the two or three faces with one quadric that misses ε by far; at full weight they
@@ -392,6 +412,7 @@ int main(void) {
         cmocka_unit_test(thin_plate),
         cmocka_unit_test(hollow_sphere),
         cmocka_unit_test(sparse_thin_plate),
+        cmocka_unit_test(thin_torus),
         cmocka_unit_test(cube),
         cmocka_unit_test(islands),
         cmocka_unit_test(scale_invariance),
