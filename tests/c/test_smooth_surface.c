@@ -114,6 +114,24 @@ static void test_noisy_torus_keeps_its_topology(void **state) {
     assert_true(fi > 0);
     assert_true(fo < 0);
     free(values);
+
+    /* The point normals follow the smooth surface: −∇f/|∇f| of the field evaluate answers,
+     * at the points (all but those beside a thin part; the torus has none). */
+    double *normals = malloc(3 * kPoints * sizeof *normals), *gradients = malloc(3 * kPoints * sizeof *gradients);
+    assert_non_null(normals);
+    assert_non_null(gradients);
+    assert_ok(gmpu_surface_copy_normals(s, normals, kPoints));
+    assert_ok(gmpu_surface_evaluate(s, xyz, kPoints, NULL, gradients));
+    size_t following = 0;
+    for (size_t i = 0; i < kPoints; ++i) {
+        const double *g = gradients + 3 * i, *n = normals + 3 * i;
+        const double len = sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2]);
+        if (len > 0 && -(g[0] * n[0] + g[1] * n[1] + g[2] * n[2]) / len > 0.9999) ++following;
+    }
+    fprintf(stderr, "# noisy torus: %zu of %d point normals along -grad f\n", following, kPoints);
+    assert_true(following >= 0.95 * kPoints);
+    free(normals);
+    free(gradients);
     gmpu_mesh_destroy(m);
     gmpu_surface_destroy(s);
     free(xyz);
