@@ -59,10 +59,7 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
     progress.report(0.0, true);
     // The steps' shares of the stage's progress.
     const bool wants_smooth = wants_smooth_surface(params, points, noise);
-    // Sparse clouds keep the blend's surface but take their point normals from a smooth solve.
-    const bool smooth_normals = !wants_smooth && params.surface == 2 && sparse_cloud(points);
-    const bool solves = wants_smooth || smooth_normals;
-    const double signs_end = solves ? 0.8 : 0.9, winding_end = solves ? 0.85 : 1.0;
+    const double signs_end = wants_smooth ? 0.8 : 0.9, winding_end = wants_smooth ? 0.85 : 1.0;
     Progress signs_progress = progress.slice(0.0, signs_end), measures_progress = progress.slice(signs_end, signs_end + 0.05),
              winding_progress = progress.slice(signs_end + 0.05, winding_end),
              smooth_progress = progress.slice(winding_end, 1.0);
@@ -78,7 +75,7 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
     winding = WindingField(tree, points, measures.blend_normals, measures.area, &winding_progress);
     std::shared_ptr<const SmoothField> new_smooth =
         wants_smooth ? solve_smooth_surface(params, tree, points, measures, noise, smooth_progress) : nullptr;
-    if (smooth_normals) measures.normals = smooth_point_normals(params, points, measures, noise, smooth_progress);
+    // Where the surface is the smooth field, the point normals follow it.
     if (new_smooth) {
         Progress read_progress = smooth_progress.slice(1.0, 1.0);
         measures.normals = field_point_normals(*new_smooth, points, measures, read_progress);

@@ -237,62 +237,12 @@ static void test_solve_reports_and_cancels(void **state) {
     free(xyz);
 }
 
-/* Sparse clouds: the point normals come from a smooth field solved from the blend's oriented
- * normals (pipeline/smooth_normals.hpp), the surface stays the blend. On a sparse subsample
- * of a shared cloud (every 35th point of the 35k bunny: 1,000 points, true normals known) the local fits of a
- * dozen points put some normals on the wrong side of the true one; the smooth field's
- * gradient puts fewer there. */
-static size_t wrong_normals(double surface, const double *xyz, const double *truth, size_t n) {
-    gmpu_surface *s = NULL;
-    assert_ok(gmpu_surface_create(&s));
-    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_SURFACE, surface));
-    assert_ok(gmpu_surface_set_points_f64(s, xyz, n, 0));
-    assert_ok(gmpu_surface_fit(s));
-    assert_ok(gmpu_surface_orient(s));
-    double *normals = malloc(3 * n * sizeof *normals);
-    assert_non_null(normals);
-    assert_ok(gmpu_surface_copy_normals(s, normals, n));
-    size_t wrong = 0;
-    for (size_t i = 0; i < n; ++i)
-        if (truth[3 * i] * normals[3 * i] + truth[3 * i + 1] * normals[3 * i + 1] + truth[3 * i + 2] * normals[3 * i + 2] <= 0)
-            ++wrong;
-    free(normals);
-    gmpu_surface_destroy(s);
-    return wrong;
-}
-
-static void test_sparse_normals_from_the_smooth_field(void **state) {
-    (void)state;
-    char path[4096];
-    snprintf(path, sizeof path, "%s/clouds/bunny_clean_gt.ply", getenv("GMPU_TEST_DATA") ? getenv("GMPU_TEST_DATA") : "tests/data");
-    gmpu_points *cloud = NULL;
-    assert_ok(gmpu_points_read(path, &cloud));
-    const size_t all = gmpu_points_count(cloud), stride = 35, n = all / stride;
-    assert_non_null(gmpu_points_normals(cloud));
-    double *xyz = malloc(3 * n * sizeof *xyz), *truth = malloc(3 * n * sizeof *truth);
-    assert_non_null(xyz);
-    assert_non_null(truth);
-    for (size_t i = 0; i < n; ++i)
-        for (int d = 0; d < 3; ++d) {
-            xyz[3 * i + d] = gmpu_points_positions(cloud)[3 * i * stride + d];
-            truth[3 * i + d] = gmpu_points_normals(cloud)[3 * i * stride + d];
-        }
-    const size_t blend = wrong_normals(0, xyz, truth, n), automatic = wrong_normals(2, xyz, truth, n);
-    fprintf(stderr, "# bunny, every %zuth point (%zu): wrong normals %zu with the blend's, %zu by default\n",
-            stride, n, blend, automatic);
-    assert_true(automatic + 3 <= blend);
-    free(xyz);
-    free(truth);
-    gmpu_points_destroy(cloud);
-}
-
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_noisy_torus_keeps_its_topology),
         cmocka_unit_test(test_clean_cloud_keeps_the_blend),
         cmocka_unit_test(test_surface_parameter),
         cmocka_unit_test(test_solve_reports_and_cancels),
-        cmocka_unit_test(test_sparse_normals_from_the_smooth_field),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
