@@ -9,7 +9,7 @@
 #include "core/parallel.hpp"
 #include "mesh/block_grid.hpp"
 #include "mesh/edge_root.hpp"
-#include "mesh/marching_tetrahedra.hpp"
+#include "mesh/marching_cubes.hpp"
 #include "mesh/mesh_cleanup.hpp"
 #include "mesh/point_buckets.hpp"
 #include "mesh/sharpen.hpp"
@@ -144,10 +144,10 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuck
     f.block_values(lattice, near, near_count, touches_far ? forced.data() : nullptr, value.data());
     std::fill(slot.begin(), slot.end(), -1);
 
-    auto vertex = [&](int i, int j, int k, const mt::Edge &e) -> uint32_t {
+    auto vertex = [&](int i, int j, int k, const mc::Edge &e) -> uint32_t {
         const int ai = i + (e.from & 1), aj = j + (e.from >> 1 & 1), ak = k + (e.from >> 2 & 1);
         const int bi = i + (e.to & 1), bj = j + (e.to >> 1 & 1), bk = k + (e.to >> 2 & 1);
-        const int dir = mt::edge_direction(e);
+        const int dir = mc::edge_direction(e);
         int32_t &s = slot[size_t(local(ai, aj, ak) * 8 + dir)];
         if (s >= 0) return uint32_t(s);
         const double va = value[size_t(local(ai, aj, ak))], vb = value[size_t(local(bi, bj, bk))];
@@ -166,9 +166,9 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuck
         return uint32_t(s);
     };
 
-    mt::march_block(
+    mc::march_block(
         B, [&](int i, int j, int k) { return value[size_t(local(i, j, k))]; },
-        [&](int i, int j, int k, const mt::Edge &e) { out.triangles.push_back(vertex(i, j, k, e)); });
+        [&](int i, int j, int k, const mc::Edge &e) { out.triangles.push_back(vertex(i, j, k, e)); });
 
     // Each point inside the block votes for its nearest vertex here: the surface near the
     // data collects the votes, bubbles away from it none (see remove_unsupported_components).
