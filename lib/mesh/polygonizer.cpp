@@ -28,11 +28,10 @@ constexpr uint32_t kMinVotes = 15;
 constexpr double kCubesPerGap = 0.4;
 // Share of the points that two-sheet leaves must hold for their gap to set the grid.
 constexpr double kWallShare = 0.1;
-// Mesh size (default_resolution): triangles wanted per input point, and what marching
-// tetrahedra on the Kuhn split makes per h² of surface (measured on smooth and CAD shapes:
-// 8 to 9). At 5 the thin 35k camel was refined past two cubes per leaf and gained a handle.
-constexpr double kTrianglesPerPoint = 2.5;
-constexpr double kTrianglesPerCubeArea = 9.0;
+// Mesh size (default_resolution): the cube the point density asks for, in mean sample
+// spacings (marching cubes then makes about 0.8 triangles per point, 3 per h² of surface).
+// Finer, the thin 35k camel was refined past two cubes per leaf and gained a handle.
+constexpr double kCubePerSpacing = 1.9;
 // The coarsest cube, as a share of the median leaf (two cubes across a leaf): coarser
 // grids bridge close sheets of the fits and add handles (the noisy and the nonuniform 35k
 // bunny have one to three at 0.6 and 0.75 of a leaf).
@@ -102,7 +101,7 @@ struct SubBlockLeaves {
     }
 };
 
-// Marching tetrahedra over one band block.
+// Marching cubes over one band block.
 void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuckets &buckets, const std::vector<int64_t> &band,
                       size_t band_index, int root_steps, BlockOutput &out) {
     const int64_t block = band[band_index];
@@ -191,10 +190,9 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuck
 
 int default_resolution(const Octree &tree, const PointMeasures &measures) {
     // Half the median size of the leaves that hold points (the grid then resolves every
-    // local fit with about two cubes across), or finer where the points are dense: the cube
-    // that makes about kTrianglesPerPoint triangles per point, from the surface area the
-    // points stand for (marching tetrahedra makes about kTrianglesPerCubeArea triangles per
-    // h² of surface), down to kFinestSizeCube. Where leaves hold two sheets, the cube must
+    // local fit with about two cubes across), or finer where the points are dense:
+    // kCubePerSpacing mean sample spacings (from the surface area the points stand for),
+    // down to kFinestSizeCube. Where leaves hold two sheets, the cube must
     // also be well under their gap, or both sheets fall between two grid corners of the same
     // sign and vanish. The walls that set it must hold a real share of the points: a few
     // two-sheet leaves in a narrow slot would otherwise refine the whole grid.
@@ -216,7 +214,7 @@ int default_resolution(const Octree &tree, const PointMeasures &measures) {
     // Without areas (nothing measured): two cubes across the median leaf.
     double h = 0.5 * leaf;
     if (area > 0.0) {
-        const double sized = std::sqrt(kTrianglesPerCubeArea * area / (kTrianglesPerPoint * double(measures.area.size())));
+        const double sized = kCubePerSpacing * std::sqrt(area / double(measures.area.size()));
         h = std::min(std::max(sized, kFinestSizeCube), kCubesPerLeaf * leaf);
     }
     std::sort(walls.begin(), walls.end());
