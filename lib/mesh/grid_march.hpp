@@ -1,7 +1,7 @@
-// Marching cubes (marching_cubes.hpp) over blocks of a lattice that several independent
-// runs share (the tiles of a distributed reconstruction): the caller gives every corner's value, so two
-// runs that march neighbouring blocks with the same values on their shared face cut it
-// identically, and each vertex is named by its global lattice edge so the pieces weld
+// Marching cubes (marching_cubes.hpp) over blocks of a lattice that several independent runs
+// share (the tiles of a distributed reconstruction): the caller gives every corner's value,
+// so two runs that march neighbouring blocks with the same values on their shared face cut
+// it identically, and each vertex is named by its global lattice edge so the pieces weld
 // into one mesh whichever run made them.
 #pragma once
 
