@@ -38,7 +38,8 @@ Mesh march_grid_blocks(const GlobalGrid &grid, const int64_t *blocks, size_t blo
         };
         mc::march_block(
             B, [&](int i, int j, int k) { return value[local(i, j, k)]; },
-            [&](int i, int j, int k, const mc::Edge &e) { mesh.triangles.push_back(vertex(i, j, k, e)); });
+            [&](int i, int j, int k, const mc::Edge &e) { mesh.triangles.push_back(vertex(i, j, k, e)); },
+            [](int, int, int, const mc::Edge *) { return true; });  // no gradients here: a fixed split
     }
     return mesh;
 }

@@ -1,5 +1,6 @@
 #include "mesh/marching_cubes.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <vector>
@@ -77,7 +78,13 @@ struct Table {
             if (next[start] < 0 || used[start]) continue;
             std::vector<Edge> loop;
             for (int e = start; !used[e]; e = next[e]) used[e] = true, loop.push_back(edges.edge[e]);
-            triangulate(loop, cc);
+            // A quad's two diagonals both cross the cube's inside (its opposite vertices
+            // never share a face): the march picks one.
+            if (loop.size() == 4 && !share_face(loop[0], loop[2]) && !share_face(loop[1], loop[3]) &&
+                cc.quad_count < CubeCase::kMaxQuads)
+                std::copy(loop.begin(), loop.end(), cc.quads[cc.quad_count++]);
+            else
+                triangulate(loop, cc);
         }
     }
 

@@ -165,9 +165,24 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuck
         return uint32_t(s);
     };
 
+    // A quad splits along the diagonal whose two triangles face most like the outward
+    // normals −∇f at their vertices.
+    auto facing = [&](uint32_t a, uint32_t b, uint32_t c) {
+        const std::vector<Eigen::Vector3d> &p = out.vertex_pos, &grad = out.vertex_grad;
+        const Eigen::Vector3d n = (p[b] - p[a]).cross(p[c] - p[a]);
+        const Eigen::Vector3d g = grad[a].normalized() + grad[b].normalized() + grad[c].normalized();
+        const double scale = n.norm() * g.norm();
+        return scale > 0 ? -n.dot(g) / scale : 0.0;
+    };
     mc::march_block(
         B, [&](int i, int j, int k) { return value[size_t(local(i, j, k))]; },
-        [&](int i, int j, int k, const mc::Edge &e) { out.triangles.push_back(vertex(i, j, k, e)); });
+        [&](int i, int j, int k, const mc::Edge &e) { out.triangles.push_back(vertex(i, j, k, e)); },
+        [&](int i, int j, int k, const mc::Edge *q) {
+            uint32_t v[4];
+            for (int c = 0; c < 4; ++c) v[c] = vertex(i, j, k, q[c]);
+            return facing(v[0], v[1], v[2]) + facing(v[0], v[2], v[3]) >=
+                   facing(v[0], v[1], v[3]) + facing(v[1], v[2], v[3]);
+        });
 
     // Each point inside the block votes for its nearest vertex here: the surface near the
     // data collects the votes, bubbles away from it none (see remove_unsupported_components).
