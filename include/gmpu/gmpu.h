@@ -148,7 +148,7 @@ typedef enum gmpu_param {
      * octree cells than this (the default is about 4 GB). Default 2e7, range 1..1e9. */
     GMPU_PARAM_MAX_CELLS = 9,
     /* Resource cap: polygonize fails with GMPU_ERROR_LIMIT_EXCEEDED instead of making
-     * more triangles than this, counted as marching tetrahedra makes them (before closed
+     * more triangles than this, counted as marching cubes makes them (before closed
      * pieces that no input point supports are dropped). Default 1e8, range 1..2e9. */
     GMPU_PARAM_MAX_TRIANGLES = 10,
     /* Noise floor for ε: fit estimates the sampling noise σ̂ and works to
@@ -521,7 +521,7 @@ GMPU_API gmpu_status gmpu_surface_evaluate_grid(const gmpu_surface *surface, con
                                                 double cell_size, const int64_t *blocks, size_t block_count,
                                                 double *values);
 
-/* Marching tetrahedra (the Kuhn split gmpu_surface_polygonize uses) over the given blocks
+/* Marching cubes (the cases gmpu_surface_polygonize uses) over the given blocks
  * of the global grid, with the caller's corner values: corner_values[729·n + i + 9·(j + 9·k)]
  * for block n at corner (8·bx + i, 8·by + j, 8·bz + k), i, j, k in 0..8, positive inside.
  * Two calls that give the same value to a shared corner cut the shared face identically.
@@ -538,7 +538,7 @@ GMPU_API gmpu_status gmpu_grid_polygonize(const double *grid_origin, double cell
 
 /* Per vertex of a mesh made by gmpu_grid_polygonize: its lattice edge, (x + (cx + 1)·(y +
  * (cy + 1)·z))·8 + d for its lower corner (x, y, z), grid_cells (cx, cy, cz) and the edge's
- * direction d (0..6: the corner-offset bits xyz, minus one). Equal keys from two tiles are one
+ * direction d (0, 1 or 3: the corner-offset bit of its axis, minus one). Equal keys from two tiles are one
  * vertex. NULL for any other mesh. */
 GMPU_API const uint64_t *gmpu_mesh_grid_keys(const gmpu_mesh *mesh);
 

@@ -1,8 +1,8 @@
 // Where a grid edge crosses the zero set of f, found on f itself rather than on the linear
 // interpolant of the two corner values. The vertex stays on its edge (strictly between the
 // corners), so the polygonizer's mesh keeps its topology and its guarantees (closed,
-// edge-manifold, no self-intersection: every triangle stays inside its tetrahedron), while
-// lying on the surface: a coarser grid then loses little accuracy.
+// edge-manifold, every triangle inside its cube), while lying on the surface: a coarser
+// grid then loses little accuracy.
 #pragma once
 
 #include <algorithm>

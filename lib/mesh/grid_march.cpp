@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <unordered_map>
 
-#include "mesh/marching_tetrahedra.hpp"
+#include "mesh/marching_cubes.hpp"
 
 namespace gmpu {
 
@@ -18,10 +18,10 @@ Mesh march_grid_blocks(const GlobalGrid &grid, const int64_t *blocks, size_t blo
         const int64_t x0 = blocks[3 * b] * B, y0 = blocks[3 * b + 1] * B, z0 = blocks[3 * b + 2] * B;
         const double *value = corner_values + b * size_t(C * C * C);
         auto local = [](int i, int j, int k) { return size_t(i + C * (j + C * k)); };
-        auto vertex = [&](int i, int j, int k, const mt::Edge &e) -> uint32_t {
+        auto vertex = [&](int i, int j, int k, const mc::Edge &e) -> uint32_t {
             const int ai = i + (e.from & 1), aj = j + (e.from >> 1 & 1), ak = k + (e.from >> 2 & 1);
             const int bi = i + (e.to & 1), bj = j + (e.to >> 1 & 1), bk = k + (e.to >> 2 & 1);
-            const uint64_t key = grid.corner_id(x0 + ai, y0 + aj, z0 + ak) * 8 + uint64_t(mt::edge_direction(e));
+            const uint64_t key = grid.corner_id(x0 + ai, y0 + aj, z0 + ak) * 8 + uint64_t(mc::edge_direction(e));
             auto found = vertex_of.find(key);
             if (found != vertex_of.end()) return found->second;
             const double va = value[local(ai, aj, ak)], vb = value[local(bi, bj, bk)];
@@ -36,9 +36,10 @@ Mesh march_grid_blocks(const GlobalGrid &grid, const int64_t *blocks, size_t blo
             vertex_of.emplace(key, id);
             return id;
         };
-        mt::march_block(
+        mc::march_block(
             B, [&](int i, int j, int k) { return value[local(i, j, k)]; },
-            [&](int i, int j, int k, const mt::Edge &e) { mesh.triangles.push_back(vertex(i, j, k, e)); });
+            [&](int i, int j, int k, const mc::Edge &e) { mesh.triangles.push_back(vertex(i, j, k, e)); },
+            [](int, int, int, const mc::Edge *) { return true; });  // no gradients here: a fixed split
     }
     return mesh;
 }

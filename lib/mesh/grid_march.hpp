@@ -1,7 +1,7 @@
-// Marching tetrahedra over blocks of a lattice that several independent runs share (the
-// tiles of a distributed reconstruction): the caller gives every corner's value, so two
-// runs that march neighbouring blocks with the same values on their shared face cut it
-// identically, and each vertex is named by its global lattice edge so the pieces weld
+// Marching cubes (marching_cubes.hpp) over blocks of a lattice that several independent runs
+// share (the tiles of a distributed reconstruction): the caller gives every corner's value,
+// so two runs that march neighbouring blocks with the same values on their shared face cut
+// it identically, and each vertex is named by its global lattice edge so the pieces weld
 // into one mesh whichever run made them.
 #pragma once
 
@@ -32,7 +32,7 @@ struct GlobalGrid {
 // `corner_values` per block the (kGridBlock + 1)³ values at its corners, x fastest
 // (positive inside). Vertices are in the grid's frame, unwelded across blocks only where
 // the blocks are not given together; `edge_keys` gets per vertex its lattice edge
-// (corner id × 8 + Kuhn direction).
+// (corner id × 8 + axis direction).
 Mesh march_grid_blocks(const GlobalGrid &grid, const int64_t *blocks, size_t block_count, const double *corner_values,
                        std::vector<uint64_t> &edge_keys);
 

@@ -2,7 +2,8 @@
 // tetrahedra around the 000–111 diagonal. The split is the same in every cube, so
 // neighbouring cubes cut shared faces along the same diagonals, and the isosurface of the
 // piecewise-linear interpolant is a closed 2-manifold wherever the grid's boundary has one
-// sign — which is why the polygonizer uses it instead of marching cubes' ambiguous cases.
+// sign. The polygonizer now uses marching cubes (marching_cubes.hpp: a third of the
+// triangles), which shares this file's Edge.
 #pragma once
 
 #include <cstdint>

@@ -9,7 +9,7 @@
 #include "core/parallel.hpp"
 #include "mesh/block_grid.hpp"
 #include "mesh/edge_root.hpp"
-#include "mesh/marching_tetrahedra.hpp"
+#include "mesh/marching_cubes.hpp"
 #include "mesh/mesh_cleanup.hpp"
 #include "mesh/point_buckets.hpp"
 #include "mesh/sharpen.hpp"
@@ -28,11 +28,10 @@ constexpr uint32_t kMinVotes = 15;
 constexpr double kCubesPerGap = 0.4;
 // Share of the points that two-sheet leaves must hold for their gap to set the grid.
 constexpr double kWallShare = 0.1;
-// Mesh size (default_resolution): triangles wanted per input point, and what marching
-// tetrahedra on the Kuhn split makes per h² of surface (measured on smooth and CAD shapes:
-// 8 to 9). At 5 the thin 35k camel was refined past two cubes per leaf and gained a handle.
-constexpr double kTrianglesPerPoint = 2.5;
-constexpr double kTrianglesPerCubeArea = 9.0;
+// Mesh size (default_resolution): the cube the point density asks for, in mean sample
+// spacings (marching cubes then makes about 0.8 triangles per point, 3 per h² of surface).
+// Finer, the thin 35k camel was refined past two cubes per leaf and gained a handle.
+constexpr double kCubePerSpacing = 1.9;
 // The coarsest cube, as a share of the median leaf (two cubes across a leaf): coarser
 // grids bridge close sheets of the fits and add handles (the noisy and the nonuniform 35k
 // bunny have one to three at 0.6 and 0.75 of a leaf).
@@ -102,7 +101,7 @@ struct SubBlockLeaves {
     }
 };
 
-// Marching tetrahedra over one band block.
+// Marching cubes over one band block.
 void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuckets &buckets, const std::vector<int64_t> &band,
                       size_t band_index, int root_steps, BlockOutput &out) {
     const int64_t block = band[band_index];
@@ -144,10 +143,10 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuck
     f.block_values(lattice, near, near_count, touches_far ? forced.data() : nullptr, value.data());
     std::fill(slot.begin(), slot.end(), -1);
 
-    auto vertex = [&](int i, int j, int k, const mt::Edge &e) -> uint32_t {
+    auto vertex = [&](int i, int j, int k, const mc::Edge &e) -> uint32_t {
         const int ai = i + (e.from & 1), aj = j + (e.from >> 1 & 1), ak = k + (e.from >> 2 & 1);
         const int bi = i + (e.to & 1), bj = j + (e.to >> 1 & 1), bk = k + (e.to >> 2 & 1);
-        const int dir = mt::edge_direction(e);
+        const int dir = mc::edge_direction(e);
         int32_t &s = slot[size_t(local(ai, aj, ak) * 8 + dir)];
         if (s >= 0) return uint32_t(s);
         const double va = value[size_t(local(ai, aj, ak))], vb = value[size_t(local(bi, bj, bk))];
@@ -166,9 +165,24 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuck
         return uint32_t(s);
     };
 
-    mt::march_block(
+    // A quad splits along the diagonal whose two triangles face most like the outward
+    // normals −∇f at their vertices.
+    auto facing = [&](uint32_t a, uint32_t b, uint32_t c) {
+        const std::vector<Eigen::Vector3d> &p = out.vertex_pos, &grad = out.vertex_grad;
+        const Eigen::Vector3d n = (p[b] - p[a]).cross(p[c] - p[a]);
+        const Eigen::Vector3d g = grad[a].normalized() + grad[b].normalized() + grad[c].normalized();
+        const double scale = n.norm() * g.norm();
+        return scale > 0 ? -n.dot(g) / scale : 0.0;
+    };
+    mc::march_block(
         B, [&](int i, int j, int k) { return value[size_t(local(i, j, k))]; },
-        [&](int i, int j, int k, const mt::Edge &e) { out.triangles.push_back(vertex(i, j, k, e)); });
+        [&](int i, int j, int k, const mc::Edge &e) { out.triangles.push_back(vertex(i, j, k, e)); },
+        [&](int i, int j, int k, const mc::Edge *q) {
+            uint32_t v[4];
+            for (int c = 0; c < 4; ++c) v[c] = vertex(i, j, k, q[c]);
+            return facing(v[0], v[1], v[2]) + facing(v[0], v[2], v[3]) >=
+                   facing(v[0], v[1], v[3]) + facing(v[1], v[2], v[3]);
+        });
 
     // Each point inside the block votes for its nearest vertex here: the surface near the
     // data collects the votes, bubbles away from it none (see remove_unsupported_components).
@@ -191,10 +205,9 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuck
 
 int default_resolution(const Octree &tree, const PointMeasures &measures) {
     // Half the median size of the leaves that hold points (the grid then resolves every
-    // local fit with about two cubes across), or finer where the points are dense: the cube
-    // that makes about kTrianglesPerPoint triangles per point, from the surface area the
-    // points stand for (marching tetrahedra makes about kTrianglesPerCubeArea triangles per
-    // h² of surface), down to kFinestSizeCube. Where leaves hold two sheets, the cube must
+    // local fit with about two cubes across), or finer where the points are dense:
+    // kCubePerSpacing mean sample spacings (from the surface area the points stand for),
+    // down to kFinestSizeCube. Where leaves hold two sheets, the cube must
     // also be well under their gap, or both sheets fall between two grid corners of the same
     // sign and vanish. The walls that set it must hold a real share of the points: a few
     // two-sheet leaves in a narrow slot would otherwise refine the whole grid.
@@ -216,7 +229,7 @@ int default_resolution(const Octree &tree, const PointMeasures &measures) {
     // Without areas (nothing measured): two cubes across the median leaf.
     double h = 0.5 * leaf;
     if (area > 0.0) {
-        const double sized = std::sqrt(kTrianglesPerCubeArea * area / (kTrianglesPerPoint * double(measures.area.size())));
+        const double sized = kCubePerSpacing * std::sqrt(area / double(measures.area.size()));
         h = std::min(std::max(sized, kFinestSizeCube), kCubesPerLeaf * leaf);
     }
     std::sort(walls.begin(), walls.end());

@@ -1,9 +1,9 @@
 // Polygonize stage: the zero set of f as a closed, edge-manifold, consistently wound mesh.
-// Marching tetrahedra over the band of a sparse block grid (block_grid.hpp): corners near
-// the data take the implicit's value, corners touching the far regions take their region's
-// sign, so every surface closes inside the band and zero sets of far-away quadrics never
-// become surface. Blocks are independent (run in parallel) and agree on shared corners
-// because every corner's value is a function of its position alone.
+// Marching cubes (marching_cubes.hpp) over the band of a sparse block grid (block_grid.hpp):
+// corners near the data take the implicit's value, corners touching the far regions take
+// their region's sign, so every surface closes inside the band and zero sets of far-away
+// quadrics never become surface. Blocks are independent (run in parallel) and agree on
+// shared corners because every corner's value is a function of its position alone.
 #pragma once
 
 #include "core/parallel.hpp"
@@ -16,10 +16,10 @@
 
 namespace gmpu {
 
-// Grid resolution (cubes along the longest side) that follows the data: cubes about the
-// size that gives a mesh of kTrianglesPerPoint triangles per input point (from the points'
-// areas, so dense data gets a finer grid), never coarser than the octree's leaves (every
-// local fit keeps a cube across) nor than the gap of a thin wall's two sheets.
+// Grid resolution (cubes along the longest side) that follows the data: cubes about twice
+// the mean sample spacing (from the points' areas, so dense data gets a finer grid), never
+// coarser than the octree's leaves (every local fit keeps a cube across) nor than the gap of
+// a thin wall's two sheets.
 int default_resolution(const Octree &tree, const PointMeasures &measures);
 
 // `noise`: the fit's noise estimate σ̂ (normalised units). On clean, dense data (σ̂ well

@@ -1,4 +1,4 @@
-// Sharp edges and corners put back on the polygonizer's mesh. Marching tetrahedra places
+// Sharp edges and corners put back on the polygonizer's mesh. Marching cubes places
 // vertices on grid edges, so a crease between two faces comes out cut by a chamfer about a
 // cube wide even where f itself has the crease. Each vertex whose neighbours' normals (∇f at
 // the vertices) spread past a feature angle moves to the point that best fits the tangent

@@ -13,7 +13,7 @@
 
 namespace gmpu {
 
-// What marching tetrahedra made in one block.
+// What marching cubes made in one block.
 struct BlockOutput {
     std::vector<uint64_t> vertex_key;         // grid edge per vertex: corner id × 8 + direction
     std::vector<Eigen::Vector3d> vertex_pos;  // normalised frame

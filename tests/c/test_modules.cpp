@@ -36,6 +36,7 @@
 #include "geometry/point_set.hpp"
 #include "implicit/mpu_function.hpp"
 #include "implicit/winding_field.hpp"
+#include "mesh/marching_cubes.hpp"
 #include "mesh/marching_tetrahedra.hpp"
 #include "mesh/mesh_cleanup.hpp"
 #include "orient/belief_propagation.hpp"
@@ -586,6 +587,126 @@ void marching_tetrahedra_closes_any_sign_field(void **) {
     }
 }
 
+// ---- marching cubes ---------------------------------------------------------------------
+
+// Marches an n³-corner field with marching cubes, welding vertices by grid edge; returns
+// the triangles (vertex ids) and the vertices' positions (linear interpolation).
+std::vector<uint32_t> march_cubes(const std::vector<double> &v, int n, std::vector<Eigen::Vector3d> *positions = nullptr) {
+    auto id = [&](int i, int j, int k) { return i + n * (j + n * k); };
+    std::map<uint64_t, uint32_t> vertex;
+    std::vector<uint32_t> tris;
+    std::mt19937 coin{7};  // quads split either way: the surface closes whatever the choice
+    mc::march_block(
+        n - 1, [&](int i, int j, int k) { return v[size_t(id(i, j, k))]; },
+        [&](int i, int j, int k, const mc::Edge &e) {
+            const Eigen::Vector3i a(i + (e.from & 1), j + (e.from >> 1 & 1), k + (e.from >> 2 & 1));
+            const Eigen::Vector3i b(i + (e.to & 1), j + (e.to >> 1 & 1), k + (e.to >> 2 & 1));
+            const uint64_t key = uint64_t(id(a[0], a[1], a[2])) * 8 + uint64_t(mc::edge_direction(e));
+            auto [it, added] = vertex.emplace(key, uint32_t(vertex.size()));
+            if (added && positions) {
+                const double va = v[size_t(id(a[0], a[1], a[2]))], vb = v[size_t(id(b[0], b[1], b[2]))];
+                positions->push_back(a.cast<double>() + va / (va - vb) * (b - a).cast<double>());
+            }
+            tris.push_back(it->second);
+        },
+        [&](int, int, int, const mc::Edge *) { return coin() & 1; });
+    return tris;
+}
+
+// Closed (every edge has its twin), edge-manifold and consistently wound (no directed edge
+// twice), every vertex's triangles one fan (no two cones touching at a vertex).
+void assert_closed_manifold(const std::vector<uint32_t> &tris) {
+    std::map<std::pair<uint32_t, uint32_t>, int> directed;
+    for (size_t t = 0; t < tris.size(); t += 3)
+        for (int e = 0; e < 3; ++e) {
+            assert_true(tris[t + size_t(e)] != tris[t + size_t((e + 1) % 3)]);
+            ++directed[{tris[t + size_t(e)], tris[t + size_t((e + 1) % 3)]}];
+        }
+    std::map<uint32_t, std::map<uint32_t, uint32_t>> next_around;  // vertex → (a → b) per triangle
+    for (size_t t = 0; t < tris.size(); t += 3)
+        for (int e = 0; e < 3; ++e) next_around[tris[t + size_t(e)]][tris[t + size_t((e + 1) % 3)]] = tris[t + size_t((e + 2) % 3)];
+    for (const auto &[edge, count] : directed) {
+        assert_int_equal(count, 1);
+        assert_true(directed.count({edge.second, edge.first}) == 1);
+    }
+    for (const auto &[v, ring] : next_around) {  // walking the fan once visits every triangle
+        size_t steps = 0;
+        uint32_t at = ring.begin()->first;
+        do at = ring.at(at), ++steps;
+        while (at != ring.begin()->first && steps <= ring.size());
+        assert_int_equal(steps, ring.size());
+    }
+}
+
+void cube_cases_cut_sign_changes_outward(void **) {
+    // Every vertex lies on an edge joining an inside and an outside corner; a lone inside
+    // corner gets one triangle facing away from it.
+    for (int mask = 0; mask < 256; ++mask) {
+        const mc::CubeCase &c = mc::cube_case(mask);
+        const int inside = __builtin_popcount(unsigned(mask));
+        if (inside == 0 || inside == 8) assert_int_equal(c.triangle_count + c.quad_count, 0);
+        else assert_true(c.triangle_count + c.quad_count > 0);
+        for (int t = 0; t < c.triangle_count; ++t)
+            for (const mc::Edge &e : c.triangles[t]) assert_true(((mask >> e.from) & 1) != ((mask >> e.to) & 1));
+        for (int q = 0; q < c.quad_count; ++q)
+            for (int v = 0; v < 4; ++v) assert_true(((mask >> c.quads[q][v].from) & 1) != ((mask >> c.quads[q][v].to) & 1));
+    }
+    for (int corner = 0; corner < 8; ++corner) {
+        const mc::CubeCase &c = mc::cube_case(1 << corner);
+        assert_int_equal(c.triangle_count, 1);
+        auto mid = [](const mc::Edge &e) -> Eigen::Vector3d {
+            return 0.5 * Eigen::Vector3d((e.from & 1) + (e.to & 1), (e.from >> 1 & 1) + (e.to >> 1 & 1),
+                                         (e.from >> 2 & 1) + (e.to >> 2 & 1));
+        };
+        const Eigen::Vector3d a = mid(c.triangles[0][0]), b = mid(c.triangles[0][1]), d = mid(c.triangles[0][2]);
+        const Eigen::Vector3d at(corner & 1, corner >> 1 & 1, corner >> 2 & 1);
+        assert_true((b - a).cross(d - a).dot(a - at) > 0);
+    }
+}
+
+void marching_cubes_closes_any_sign_field(void **) {
+    // Random values and near-saddles (a checkerboard of signs, so nearly every face is
+    // ambiguous) on 9³ grids with a negative border: closed, edge-manifold, one fan per
+    // vertex, outward (positive enclosed volume).
+    const int n = 9;
+    auto id = [&](int i, int j, int k) { return i + n * (j + n * k); };
+    for (int seed = 0; seed < 40; ++seed) {
+        std::mt19937_64 rng{uint64_t(seed)};
+        std::uniform_real_distribution<double> u(-1, 1);
+        std::vector<double> v(n * n * n);
+        for (int k = 0; k < n; ++k)
+            for (int j = 0; j < n; ++j)
+                for (int i = 0; i < n; ++i) {
+                    const bool border = i == 0 || j == 0 || k == 0 || i == n - 1 || j == n - 1 || k == n - 1;
+                    const double checker = (i + j + k) % 2 ? 1.0 : -1.0;
+                    v[size_t(id(i, j, k))] = border ? -1 : seed % 2 ? checker + 0.9 * u(rng) : u(rng);
+                }
+        std::vector<Eigen::Vector3d> p;
+        const std::vector<uint32_t> tris = march_cubes(v, n, &p);
+        assert_true(tris.size() > 30);
+        assert_closed_manifold(tris);
+        double volume = 0.0;
+        for (size_t t = 0; t < tris.size(); t += 3) volume += p[tris[t]].dot(p[tris[t + 1]].cross(p[tris[t + 2]])) / 6.0;
+        assert_true(volume > 0);
+    }
+}
+
+void marching_cubes_sphere_needs_few_triangles(void **) {
+    // About 2 triangles per cube the surface crosses: at most 4 per h² of area on a sphere
+    // (marching tetrahedra's Kuhn split makes about 9).
+    const int n = 41;
+    const double r = 15.3, c = 20.1;
+    std::vector<double> v(size_t(n) * n * n);
+    for (int k = 0; k < n; ++k)
+        for (int j = 0; j < n; ++j)
+            for (int i = 0; i < n; ++i) v[size_t(i + n * (j + n * k))] = r - Eigen::Vector3d(i - c, j - c, k - c).norm();
+    const std::vector<uint32_t> tris = march_cubes(v, n);
+    assert_closed_manifold(tris);
+    const double per_area = double(tris.size() / 3) / (4 * M_PI * r * r);
+    fprintf(stderr, "  sphere: %.2f triangles per cube area\n", per_area);
+    assert_true(per_area < 4.0);
+}
+
 // ---- mesh clean-up ----------------------------------------------------------------------
 
 void unsupported_components_are_dropped(void **) {
@@ -772,6 +893,9 @@ int main(void) {
         cmocka_unit_test(bp_data_term_breaks_ties_only),
         cmocka_unit_test(tetrahedra_cases_separate_signs),
         cmocka_unit_test(marching_tetrahedra_closes_any_sign_field),
+        cmocka_unit_test(cube_cases_cut_sign_changes_outward),
+        cmocka_unit_test(marching_cubes_closes_any_sign_field),
+        cmocka_unit_test(marching_cubes_sphere_needs_few_triangles),
         cmocka_unit_test(unsupported_components_are_dropped),
         cmocka_unit_test(parallel_for_runs_each_index_once),
         cmocka_unit_test(parallel_for_rethrows_and_cancels),
