@@ -17,8 +17,10 @@ constexpr size_t kAroundNeighbours = 12;
 // where the data has ended, is cut about a third as far out.
 constexpr double kPastEdgeFactor = 3.0;
 // The factor ramps up as the widest gap between the nearby points grows from a half-turn
-// (a vertex on the rim) to this: twelve random samples around an interior vertex now and
-// then leave a gap a little over a half-turn, and they should not count as an edge.
+// (a vertex on the rim) to three quarters of a turn, so that a gap a little over a
+// half-turn, which twelve random samples leave around about one interior vertex in 170,
+// hardly counts. (More neighbours make such gaps rarer but reach across small holes, whose
+// caps then look surrounded.)
 constexpr double kPastEdgeGap = 1.5 * M_PI;
 
 // The widest angular gap between the points `nearest` to q, seen in the plane through q
