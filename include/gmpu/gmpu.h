@@ -357,7 +357,8 @@ GMPU_API gmpu_status gmpu_surface_orient(gmpu_surface *surface);
  * or 1 and by the nearby points' normals elsewhere: never zero there, so no surface.
  * Honours GMPU_PARAM_LEVEL. Safe to call from several threads at once after orient.
  * Errors: INVALID_ARGUMENT (NULL; a count whose 3 × count doubles overflow), WRONG_ORDER
- * (not oriented), INVALID_INPUT (a NaN or infinite query, with its index; outputs untouched). Cost: O(count × log cells). */
+ * (not oriented; or GMPU_PARAM_SURFACE changed since orient and no polygonize has made that
+ * surface yet), INVALID_INPUT (a NaN or infinite query, with its index; outputs untouched). Cost: O(count × log cells). */
 GMPU_API gmpu_status gmpu_surface_evaluate(const gmpu_surface *surface, const double *xyz,
                                            size_t count, double *values, double *gradients);
 
