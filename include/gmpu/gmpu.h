@@ -357,7 +357,8 @@ GMPU_API gmpu_status gmpu_surface_orient(gmpu_surface *surface);
  * or 1 and by the nearby points' normals elsewhere: never zero there, so no surface.
  * Honours GMPU_PARAM_LEVEL. Safe to call from several threads at once after orient.
  * Errors: INVALID_ARGUMENT (NULL; a count whose 3 × count doubles overflow), WRONG_ORDER
- * (not oriented), INVALID_INPUT (a NaN or infinite query, with its index; outputs untouched). Cost: O(count × log cells). */
+ * (not oriented; or GMPU_PARAM_SURFACE changed since orient and no polygonize has made that
+ * surface yet), INVALID_INPUT (a NaN or infinite query, with its index; outputs untouched). Cost: O(count × log cells). */
 GMPU_API gmpu_status gmpu_surface_evaluate(const gmpu_surface *surface, const double *xyz,
                                            size_t count, double *values, double *gradients);
 
@@ -407,8 +408,10 @@ GMPU_API const double *gmpu_mesh_normals(const gmpu_mesh *mesh);
 /* Three vertex indices per triangle (3 × triangle_count). */
 GMPU_API const uint32_t *gmpu_mesh_triangles(const gmpu_mesh *mesh);
 /* How well the input supports each vertex (vertex_count doubles): the distance to the
- * nearest input point in units of that point's sample spacing. About 0.5 or less where the
- * points sample the surface; several where the surface bridges a hole of the scan. NULL
+ * nearest input point in units of that point's sample spacing, up to tripled past the edge
+ * of the data (where the nearest points all lie to one side of the vertex, as beyond a
+ * hole's rim). About 0.5 or less where the points sample the surface; several where the
+ * surface bridges a hole of the scan. NULL
  * for a mesh made by gmpu_mesh_create. Simplify and trim carry it; .ply files get it as
  * a float vertex property "confidence". */
 GMPU_API const double *gmpu_mesh_confidence(const gmpu_mesh *mesh);
@@ -439,7 +442,7 @@ GMPU_API gmpu_status gmpu_mesh_simplify(const gmpu_mesh *mesh, size_t target_tri
                                         gmpu_mesh **out);
 
 /* Trimming an open scan: a new mesh without the triangles that have a vertex whose
- * confidence is above threshold (in sample spacings; 2 to 4 removes the caps polygonize
+ * confidence is above threshold (in sample spacings; 1.2 to 3 removes the caps polygonize
  * closes holes with), so the result has boundaries where the data has holes. Errors:
  * INVALID_ARGUMENT (NULL, threshold not finite and positive, a mesh without confidence),
  * OUT_OF_MEMORY. */

@@ -309,6 +309,12 @@ GMPU_API gmpu_status gmpu_surface_evaluate(const gmpu_surface *s, const double *
             if (!std::isfinite(xyz[i]))
                 throw Error(GMPU_ERROR_INVALID_INPUT, "query point " + std::to_string(i / 3) + " is NaN or infinite");
         if (s->parts) return s->parts->evaluate(xyz, count, values, gradients);
+        // Evaluate may run on several threads at once, so it cannot solve or drop the smooth
+        // field itself; answering from the other surface would be silently wrong.
+        if (!s->field_matches(s->params))
+            throw Error(GMPU_ERROR_WRONG_ORDER,
+                        "gmpu_surface_evaluate: GMPU_PARAM_SURFACE changed since the surface was made; call "
+                        "gmpu_surface_polygonize or gmpu_surface_orient first");
         s->evaluate(s->params, xyz, count, values, gradients);
     });
 }

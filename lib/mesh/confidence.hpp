@@ -13,8 +13,10 @@
 namespace gmpu {
 
 // Per vertex: distance to the nearest input point divided by that point's sample spacing
-// (the square root of the area it stands for). About 0.5 or less on sampled surface;
-// several where the surface bridges a hole. Fills mesh.confidence.
+// (the square root of the area it stands for), up to tripled where the vertex lies past the
+// edge of the data (its nearest points, seen in its tangent plane, leave a gap wider than a
+// half-turn around it: beyond a hole's rim). About 0.5 or less on sampled surface; several where the surface
+// bridges a hole. Fills mesh.confidence.
 void compute_confidence(Mesh &mesh, const PointSet &points, const PointMeasures &measures, Workers &workers,
                         Progress &progress);
 

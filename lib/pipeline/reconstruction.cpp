@@ -103,6 +103,10 @@ int Reconstruction::default_resolution(const Params &params) const {
                                                        : gmpu::default_resolution(tree, measures);
 }
 
+bool Reconstruction::field_matches(const Params &params) const {
+    return wants_smooth_surface(params, points, noise) == bool(smooth);
+}
+
 void Reconstruction::evaluate(const Params &params, const double *xyz, size_t count, double *values,
                               double *gradients) const {
     const SurfaceField f = field(params.level);

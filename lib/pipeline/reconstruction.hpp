@@ -51,8 +51,12 @@ struct Reconstruction {
     // Polygonize's grid when GMPU_PARAM_RESOLUTION is 0: the smooth field's when `params`
     // asks for it, else the octree's (polygonizer.hpp: default_resolution).
     int default_resolution(const Params &params) const;
+    // Whether the field matches `params`: the smooth field is there exactly when
+    // GMPU_PARAM_SURFACE asks for it (false after the parameter changed since the last orient
+    // or polygonize, until one of them solves or drops it).
+    bool field_matches(const Params &params) const;
     // f and ∇f (world frame values, unit-free gradients) at `count` world points; either
-    // output may be null. Requires an oriented reconstruction.
+    // output may be null. Requires an oriented reconstruction whose field matches `params`.
     void evaluate(const Params &params, const double *xyz, size_t count, double *values, double *gradients) const;
 
     // The surface field of the oriented reconstruction, blended down to `level` (0: the

@@ -211,6 +211,41 @@ void trim_opens_the_hole(void **) {
     gmpu_mesh_destroy(m);
 }
 
+// The same half-scanned sphere trimmed at 1.5 spacings: past the rim the data has ended,
+// so what the trim keeps stops within a spacing of it (the distance alone would keep
+// surface twice as far out). Measured against the scanned part itself: the sphere below
+// the rim, and the rim circle. (At 1.5 spacings this sparse random sample also loses a few
+// triangles inside the scanned part, where its gaps are widest.)
+void trim_stops_at_the_rim(void **) {
+    const double r = 1.0, rim = 0.6;
+    std::vector<Vec3> pts;
+    for (const Vec3 &p : Sphere(Vec3(0, 0, 0), r).sample(6000, 9).positions)
+        if (p.z() < rim * r) pts.push_back(p);
+    const double spacing = std::sqrt(4.0 * M_PI * r * r / 6000.0);
+    gmpu_mesh *m = polygonize(pts);
+    assert_non_null(m);
+    gmpu_mesh *trimmed = nullptr;
+    assert_int_equal(gmpu_mesh_trim(m, 1.5, &trimmed), GMPU_OK);
+    const TriangleMesh t = arrays(trimmed);
+    auto off_the_scan = [&](const Vec3 &p) {
+        const Vec3 on_sphere = p.normalized() * r;
+        if (on_sphere.z() <= rim * r) return std::fabs(p.norm() - r);
+        const double around = std::hypot(p.x(), p.y());
+        const Vec3 on_rim = around > 0 ? Vec3(p.x() / around * 0.8 * r, p.y() / around * 0.8 * r, rim * r)
+                                       : Vec3(0.8 * r, 0, rim * r);
+        return (p - on_rim).norm();
+    };
+    double farthest = 0;
+    for (const Vec3 &p : t.vertices) farthest = std::max(farthest, off_the_scan(p));
+    const MeshCheck ct = check_mesh(t);
+    fprintf(stderr, "  trimmed at 1.5: farthest vertex %.2f spacings off the scanned part; %zu components, chi %ld\n",
+            farthest / spacing, ct.components, ct.component_reports[0].euler_characteristic);
+    assert_true(farthest < 1.0 * spacing);
+    assert_true(ct.component_reports[0].triangles >= 0.99 * double(t.triangles.size()));
+    gmpu_mesh_destroy(trimmed);
+    gmpu_mesh_destroy(m);
+}
+
 // The confidence is a float property of the .ply the mesh writes.
 void confidence_in_ply(void **) {
     gmpu_mesh *m = polygonize(Sphere(Vec3(0, 0, 0), 1).sample(2000, 2).positions);
@@ -391,6 +426,7 @@ int main(void) {
         cmocka_unit_test(simplify_error_bound_alone),
         cmocka_unit_test(simplify_bad_arguments),
         cmocka_unit_test(trim_opens_the_hole),
+        cmocka_unit_test(trim_stops_at_the_rim),
         cmocka_unit_test(confidence_in_ply),
         cmocka_unit_test(level_of_detail_keeps_the_topology_of_the_full_surface),
         cmocka_unit_test(mesh_size_follows_the_points),

@@ -163,8 +163,9 @@ static void test_clean_cloud_keeps_the_blend(void **state) {
 }
 
 /* The parameter is read and bounded like every other; changing it after orient is honoured
- * by polygonize (which solves or drops the smooth field); the solve checks its memory
- * estimate against the budget before allocating. */
+ * by polygonize (which solves or drops the smooth field), and evaluate refuses until then
+ * rather than answer from the other surface; the solve checks its memory estimate against
+ * the budget before allocating. */
 static void test_surface_parameter(void **state) {
     (void)state;
     gmpu_surface *s = NULL;
@@ -182,6 +183,7 @@ static void test_surface_parameter(void **state) {
     double blend = 0, smooth = 0;
     assert_ok(gmpu_surface_evaluate(s, q, 1, &blend, NULL));
     assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_SURFACE, 1));
+    check_failure(gmpu_surface_evaluate(s, q, 1, &smooth, NULL), GMPU_ERROR_WRONG_ORDER, "GMPU_PARAM_SURFACE");
     gmpu_mesh *m = NULL;
     assert_ok(gmpu_surface_polygonize(s, &m));
     assert_null(robust_mesh_problem(m));
