@@ -141,6 +141,81 @@ class _Source:
             np.concatenate([p for _, p in self.chunks()])
 
 
+class _TileFiles:
+    """A tile's points as the sorting pass left them: files of (global index, x, y, z)."""
+
+    def __init__(self, paths: Sequence[str], count: int):
+        self.paths, self.count = list(paths), count
+
+    def select(self, lo: np.ndarray, hi: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+        parts = [np.load(p) for p in self.paths]
+        if not parts:
+            return np.zeros(0, np.int64), np.zeros((0, 3))
+        rows = np.concatenate(parts)
+        xyz = np.stack([rows["x"], rows["y"], rows["z"]], axis=1).astype(np.float64)
+        keep = np.all((xyz >= lo) & (xyz < hi), axis=1)
+        return rows["index"][keep], xyz[keep]
+
+
+def _sort_chunk(source: "_Source", plan: "TilePlan", start: int, directory: str) -> List[Tuple[int, str]]:
+    """One pass of the points [start, start + chunk): each point written to the file of every
+    tile whose box plus margin holds it (tile t, chunk c: t<t>_<c>.npy). Returns (tile,
+    file) per file written. Each tile then reads only its own points, instead of every tile
+    scanning the whole cloud."""
+    g, m = plan.grid, plan.margin
+    if source.layout:
+        rows = source._mapped()[start:start + _CHUNK]
+        xyz = np.stack([rows["x"], rows["y"], rows["z"]], axis=1)
+    else:
+        xyz = source.array[start:start + _CHUNK]
+    p = xyz.astype(np.float64)
+    size = BLOCK * g.cell
+    block = np.floor((p - g.origin) / size).astype(np.int64)
+    owner = _tile_of_block(plan)
+    lo = np.array([bl for bl, _ in plan.tiles]) * size + g.origin - m
+    hi = np.array([bh for _, bh in plan.tiles]) * size + g.origin + m
+    reach = int(np.ceil(m / size))
+    pairs = []
+    for dz in range(-reach, reach + 1):
+        for dy in range(-reach, reach + 1):
+            for dx in range(-reach, reach + 1):
+                b = block + np.array([dx, dy, dz])
+                ok = np.all((b >= 0) & (b < g.blocks), axis=1)
+                t = np.where(ok, owner[g.block_key(np.where(ok[:, None], b, 0))], -1)
+                inside = (t >= 0) & np.all((p >= lo[t]) & (p < hi[t]), axis=1)
+                pairs.append(np.flatnonzero(inside) * len(plan.tiles) + t[inside])
+    code = np.unique(np.concatenate(pairs))
+    point, tile = code // len(plan.tiles), code % len(plan.tiles)
+    dtype = np.dtype([("index", "<i8"), ("x", xyz.dtype), ("y", xyz.dtype), ("z", xyz.dtype)])
+    written = []
+    order = np.argsort(tile, kind="stable")
+    tile, point = tile[order], point[order]
+    bounds = np.flatnonzero(np.diff(tile)) + 1
+    for a, b in zip(np.r_[0, bounds], np.r_[bounds, len(tile)]):
+        if a == b:
+            continue
+        t = int(tile[a])
+        out = np.empty(b - a, dtype)
+        out["index"] = start + point[a:b]
+        for d, name in enumerate("xyz"):
+            out[name] = xyz[point[a:b], d]
+        path = os.path.join(directory, f"t{t}_{start}.npy")
+        with open(path + ".part", "wb") as f:  # renamed whole: a rerun after a lost worker rewrites it
+            np.save(f, out)
+        os.replace(path + ".part", path)
+        written.append((t, path))
+    return written
+
+
+def _tile_of_block(plan: "TilePlan") -> np.ndarray:
+    owner = np.full(int(np.prod(plan.grid.blocks)), -1, np.int64)
+    nb = plan.grid.blocks
+    o = owner.reshape(nb[2], nb[1], nb[0])
+    for t, (bl, bh) in enumerate(plan.tiles):
+        o[bl[2]:bh[2], bl[1]:bh[1], bl[0]:bh[0]] = t
+    return owner
+
+
 # ---- the plan: grid and tiles -------------------------------------------------------------
 
 
@@ -303,7 +378,7 @@ def _tile_surface(source: Any, plan: TilePlan, tile: int, params: Dict[str, Any]
     """Phase 1 of a tile: its points, surface, band and corner values, the piece of each
     corner, and the normals of its overlap sample. `reverse` (tests) turns the tile's surface
     over, as if its own orientation had guessed wrong."""
-    if not isinstance(source, _Source):
+    if not isinstance(source, (_Source, _TileFiles)):
         source = _Source(array=source)
     clock = time.perf_counter()
     times: Dict[str, float] = {}
@@ -787,6 +862,7 @@ def assemble(pieces: Any, sink: Any) -> Any:
 def reconstruct(path_or_array: Any, client: Any = None, *, tile_points: int = 2_000_000, resolution: int = 0,
                 band_cells: float = 3.0, margin_cells: float = 6.0, min_component_share: float = 0.001,
                 reconcile: bool = True, stats: Optional[Dict[str, Any]] = None, output: Optional[str] = None,
+                scratch: Optional[str] = None,
                 _flip_tiles: Sequence[int] = (), **params: Any) -> Any:
     """The closed, outward-oriented mesh of a cloud (a PLY/XYZ path — binary little-endian
     PLY is memory-mapped — or an n×3 array), reconstructed in tiles of about `tile_points`
@@ -797,12 +873,14 @@ def reconstruct(path_or_array: Any, client: Any = None, *, tile_points: int = 2_
     `min_component_share` of the triangles are dropped. `output`: a .ply
     path the mesh is streamed to (the driver holds one tile's piece at a time; the file
     appears complete or not at all), and the call returns its vertex and face counts
-    instead of the mesh. Other keywords are gmpu.Surface
+    instead of the mesh. `scratch`: where the sorting pass of a file's points leaves each
+    tile's points (default: the temporary directory; on a cluster, a directory every
+    worker sees), removed at the end. Other keywords are gmpu.Surface
     parameters for every tile. `stats`, if a dict, receives the plan's figures.
     `reconcile=False` keeps every tile's own orientation (for comparison: an open patch's
     orientation is a guess); `_flip_tiles` (tests) turns those tiles' surfaces over."""
     from distributed import Client, get_client
-    own_client = None
+    own_client = scratch_dir = None
     if client is None:
         try:
             client = get_client()
@@ -827,8 +905,19 @@ def reconstruct(path_or_array: Any, client: Any = None, *, tile_points: int = 2_
                           resolution=resolution, band_cells=band_cells, margin_cells=margin_cells)
         g = plan.grid
         # Tasks get the points as a shared future (an array) or the path (each maps the file).
-        data = client.scatter(source.array, broadcast=False) if source.layout is None else source
-        phase1 = [client.submit(_tile_surface, data, plan, t, params, t in _flip_tiles, pure=False)
+        if source.layout is None:  # an array: a shared future
+            data = client.scatter(source.array, broadcast=False)
+            tile_data = [data] * len(plan.tiles)
+        else:  # a file: one sorting pass, then each tile reads its own points
+            import tempfile
+            scratch_dir = tempfile.mkdtemp(prefix="gmpu-dask-", dir=scratch)
+            files: Dict[int, List[str]] = {t: [] for t in range(len(plan.tiles))}
+            for written in client.gather([client.submit(_sort_chunk, source, plan, start, scratch_dir, pure=False)
+                                          for start in range(0, source.count, _CHUNK)]):
+                for t, path in written:
+                    files[t].append(path)
+            tile_data = [_TileFiles(files[t], source.count) for t in range(len(plan.tiles))]
+        phase1 = [client.submit(_tile_surface, tile_data[t], plan, t, params, t in _flip_tiles, pure=False)
                   for t in range(len(plan.tiles))]
         summaries = client.gather([client.submit(_summary, f) for f in phase1])
         t1 = time.perf_counter()
@@ -889,6 +978,9 @@ def reconstruct(path_or_array: Any, client: Any = None, *, tile_points: int = 2_
                          seconds=time.perf_counter() - t0)
         return result
     finally:
+        if scratch_dir is not None:
+            import shutil
+            shutil.rmtree(scratch_dir, ignore_errors=True)
         if own_client is not None:
             own_client.close()
 
