@@ -9,16 +9,22 @@ How (issue 17):
 
 1. **Tiles.** The cloud's box is covered by one global grid (cubes of side ``cell``, cut in
    blocks of 8³ cubes) and split kd-wise, on block boundaries, into tiles of about
-   ``tile_points`` points. A tile task reads only its points — its box plus an overlap
-   margin — fits and orients a gmpu surface on them, finds its *band* (the blocks it owns
-   within ``band_cells`` cubes of a point) and evaluates f at the corners its band blocks own
-   (gmpu_surface_evaluate_grid: corners 8·b .. 8·b + 7, so every corner has one owner).
+   ``tile_points`` points. A file's points are sorted once, by chunk tasks, into per-tile
+   files (each tile's box plus an overlap margin of ``margin_cells`` cubes, at least the
+   band plus two cubes); a tile task reads its own, fits and orients a gmpu surface on them,
+   finds its *band* (the blocks it owns within ``band_cells`` cubes of a point) and
+   evaluates f at the corners its band blocks own (gmpu_surface_evaluate_grid: corners
+   8·b .. 8·b + 7, so every corner has one owner). The tile's points fall in *pieces*
+   (occupied cubes, 26-connected): the margin may cut a patch off the tile's main piece,
+   and orientation may turn it its own way, so every band corner is tagged with the piece
+   of the nearest occupied cube.
 2. **Global orientation.** Each tile also returns the oriented normals of a fixed subsample
-   of its overlap points. Two tiles agree when their normals on the points both hold point
-   the same way; a maximum spanning tree of the tile graph on |agreement| fixes one flip per
-   tile (a tile's own orientation of an open patch is a guess). Then the outward pass: per
-   connected group of tiles, the band corners next to the far region that touches the
-   grid's edge must be outside (f < 0); if most are not, the group is flipped.
+   of its overlap points. Two pieces (of two tiles) agree when their normals on the points
+   both hold point the same way; a maximum spanning tree of the piece graph on |agreement|
+   fixes one flip per piece (a tile's own orientation of an open patch is a guess). Then
+   the outward pass: per connected group of pieces, the band corners next to the far region
+   that touches the grid's edge must be outside (f < 0); if most are not, the group is
+   flipped.
 3. **Far regions.** Blocks outside every tile's band form regions (6-connected); the one
    at the grid's edge is outside, each enclosed one (the inside of a thick solid) takes the
    sign most band corners beside it have. A corner touching a far block takes its region's
@@ -27,6 +33,11 @@ How (issue 17):
    of its +x/+y/+z neighbour blocks from the tiles that own them, and marches its blocks
    (gmpu_grid_polygonize). Shared corners have one value, so both sides cut a shared face
    identically; vertices are keyed by lattice edge and welded by key into one closed mesh.
+5. **Assembly.** Closed pieces of the mesh under ``min_component_share`` of the triangles
+   (bubbles of the far field) are found across tiles (joined by their tile-face vertices)
+   and dropped on the workers; the driver then takes the tiles' meshes one at a time, in
+   tile order, remembering only the vertices on tile faces, and streams them to a PLY
+   (``output=``) that is renamed into place when complete.
 
 Every task is a pure function of its inputs, so a worker lost mid-run is recomputed by Dask
 and the mesh is the same.
@@ -434,7 +445,7 @@ def _tile_surface(source: Any, plan: TilePlan, tile: int, params: Dict[str, Any]
         rows.append(np.stack([hit // pieces, np.full(len(hit), f), hit % pieces, sums[hit].astype(np.int64)], axis=1))
     out["faces"] = np.concatenate(rows)
     out["values"] = values.astype(np.float32)
-    out["labels"] = labels.astype(np.int32) if pieces > 1 else None  # None: every corner in piece 0
+    out["labels"] = labels.astype(np.int16 if pieces < 1 << 15 else np.int32) if pieces > 1 else None  # None: every corner in piece 0
     out["pieces"] = pieces
     # Overlap points: those some other tile holds too. A subsample fixed by global index, so
     # both tiles pick the same points.
