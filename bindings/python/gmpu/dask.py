@@ -445,7 +445,8 @@ def _tile_surface(source: Any, plan: TilePlan, tile: int, params: Dict[str, Any]
         rows.append(np.stack([hit // pieces, np.full(len(hit), f), hit % pieces, sums[hit].astype(np.int64)], axis=1))
     out["faces"] = np.concatenate(rows)
     out["values"] = values.astype(np.float32)
-    out["labels"] = labels.astype(np.int16 if pieces < 1 << 15 else np.int32) if pieces > 1 else None  # None: every corner in piece 0
+    # None: every corner in piece 0.
+    out["labels"] = labels.astype(np.int16 if pieces < 1 << 15 else np.int32) if pieces > 1 else None
     out["pieces"] = pieces
     # Overlap points: those some other tile holds too. A subsample fixed by global index, so
     # both tiles pick the same points.
@@ -577,8 +578,8 @@ def _piece(vertices: np.ndarray, triangles: np.ndarray, keys: np.ndarray, grid: 
     vertex_component = np.zeros(len(vertices), np.int64)
     sizes = np.zeros(0, np.int64)
     if len(t):
-        graph = coo_matrix((np.ones(2 * len(t)), (np.concatenate([t[:, 0], t[:, 1]]), np.concatenate([t[:, 1], t[:, 2]]))),
-                           shape=(len(vertices),) * 2)
+        edges = (np.concatenate([t[:, 0], t[:, 1]]), np.concatenate([t[:, 1], t[:, 2]]))
+        graph = coo_matrix((np.ones(2 * len(t)), edges), shape=(len(vertices),) * 2)
         count, vertex_component = connected_components(graph, directed=False)
         component = vertex_component[t[:, 0]]
         sizes = np.bincount(component, minlength=count)
