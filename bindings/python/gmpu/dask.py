@@ -413,7 +413,19 @@ def _tile_surface(source: Any, plan: TilePlan, tile: int, params: Dict[str, Any]
                    faces=np.zeros((0, 4), np.int64), shared=np.zeros(0, np.int64),
                    shared_pieces=np.zeros(0, np.int64), normals=np.zeros((0, 3), np.float32))
         return out
+    centres, cube_piece, point_piece = _pieces(xyz, g)
+    pieces = int(cube_piece.max()) + 1
+    # Overlap points: those some other tile holds too. A subsample fixed by global index, so
+    # both tiles pick the same points.
+    inner = np.all((xyz >= own_lo + plan.margin) & (xyz < own_hi - plan.margin), axis=1)
+    stride = max(1, source.count // (len(plan.tiles) * _SHARED_SAMPLE))
+    shared = np.flatnonzero((~inner) & (idx % stride == 0))
+    out["shared"] = idx[shared]
+    out["shared_pieces"] = point_piece[shared]
+    del idx, point_piece, inner
+    lap("pieces")
     with Surface(xyz, **params) as s:
+        del xyz  # the surface holds its own copy: only it while fitting
         s.fit()
         lap("fit")
         s.orient()
@@ -421,13 +433,10 @@ def _tile_surface(source: Any, plan: TilePlan, tile: int, params: Dict[str, Any]
         blocks = g.block_of_key(keys)
         values = _evaluate_grid(s, g, blocks)
         lap("evaluate")
-        normals = s.normals
+        normals = s.normals[shared]
     if reverse:
         values, normals = -values, -normals
-    centres, cube_piece, point_piece = _pieces(xyz, g)
-    pieces = int(cube_piece.max()) + 1
     labels = _corner_pieces(centres, cube_piece, g, blocks) if pieces > 1 else np.zeros(values.shape, np.int32)
-    lap("pieces")
     v = values.reshape(-1, BLOCK, BLOCK, BLOCK)  # [block, k, j, i]
     lab = labels.reshape(-1, BLOCK, BLOCK, BLOCK)
     sg = np.sign(v).astype(np.int64)
@@ -448,14 +457,7 @@ def _tile_surface(source: Any, plan: TilePlan, tile: int, params: Dict[str, Any]
     # None: every corner in piece 0.
     out["labels"] = labels.astype(np.int16 if pieces < 1 << 15 else np.int32) if pieces > 1 else None
     out["pieces"] = pieces
-    # Overlap points: those some other tile holds too. A subsample fixed by global index, so
-    # both tiles pick the same points.
-    inner = np.all((xyz >= own_lo + plan.margin) & (xyz < own_hi - plan.margin), axis=1)
-    stride = max(1, source.count // (len(plan.tiles) * _SHARED_SAMPLE))
-    shared = (~inner) & (idx % stride == 0)
-    out["shared"] = idx[shared]
-    out["shared_pieces"] = point_piece[shared]
-    out["normals"] = normals[shared].astype(np.float32)
+    out["normals"] = normals.astype(np.float32)
     lap("votes")
     return out
 
