@@ -268,7 +268,7 @@ def _spacing(sample: np.ndarray, total: int) -> float:
 
 
 def plan_tiles(sample: np.ndarray, total: int, lo: np.ndarray, hi: np.ndarray, *, tile_points: int,
-               resolution: int = 0, band_cells: float = 3.0, margin_cells: float = 6.0) -> TilePlan:
+               resolution: int = 0, band_cells: float = 3.0, margin_cells: float = 16.0) -> TilePlan:
     """The grid and a kd split of its blocks (at the sample's median, on block boundaries)
     into 2^k tiles of at most about `tile_points` points each (the sample stands for the
     `total` points of the cloud)."""
@@ -874,7 +874,7 @@ def assemble(pieces: Any, sink: Any) -> Any:
 
 
 def reconstruct(path_or_array: Any, client: Any = None, *, tile_points: int = 2_000_000, resolution: int = 0,
-                band_cells: float = 3.0, margin_cells: float = 6.0, min_component_share: float = 0.001,
+                band_cells: float = 3.0, margin_cells: float = 16.0, min_component_share: float = 0.001,
                 reconcile: bool = True, stats: Optional[Dict[str, Any]] = None, output: Optional[str] = None,
                 scratch: Optional[str] = None,
                 _flip_tiles: Sequence[int] = (), **params: Any) -> Any:
