@@ -215,12 +215,15 @@ bench: deps-bench build
 bench-meshes: deps-bench build
 	$(PYTHON) tests/bench/mesh_ops.py --build $(BUILD) --out bench-results/mesh_ops
 
-# Tiled reconstruction on a 2-worker Dask LocalCluster against the one-process path, 10M points
-# (tests/bench/dask_bench.py; DASK_POINTS overrides the size).
+# Tiled reconstruction on a 2-worker Dask LocalCluster against the one-process path, 10M points,
+# and the scale point: a mosaic of 10×10 bunnies, 100M points, tiled only, the mesh streamed
+# (tests/bench/dask_bench.py; DASK_POINTS, DASK_SCALE_POINTS override the sizes).
 DASK_POINTS ?= 10000000
+DASK_SCALE_POINTS ?= 100000000
 .PHONY: bench-dask
 bench-dask: deps-bench build
-	$(PYTHON) tests/bench/dask_bench.py --build $(BUILD) --out bench-results/dask --points $(DASK_POINTS) --kill-check 1000000
+	$(PYTHON) tests/bench/dask_bench.py --build $(BUILD) --out bench-results/dask --points $(DASK_POINTS) --kill-check 1000000 \
+		--scale-points $(DASK_SCALE_POINTS)
 
 # The corpus section alone (issue 13's targets on 106 generated clouds).
 bench-corpus: deps-bench build

@@ -56,6 +56,40 @@ def write_cloud(path, n, seed=17):
             out.write(p.astype("<f4").tobytes())
 
 
+def write_mosaic(path, n, side, seed=17):
+    """A scale cloud: `side`×`side` bunnies on a ground grid (each turned about the vertical
+    and scaled at random, a bunny's width apart), n points in all, area-uniform on each,
+    written in chunks to a float32 binary PLY (the tiles memory-map it). One closed piece
+    per bunny."""
+    v, f = read_off(REPO / "tests" / "data" / "meshes" / "bunny00.off")
+    v = v - v.mean(0)
+    width = float(np.ptp(v, axis=0).max())
+    rng = np.random.default_rng(seed)
+    copies = side * side
+    per = np.full(copies, n // copies)
+    per[: n - per.sum()] += 1
+    with open(path, "wb") as out:
+        out.write(f"ply\nformat binary_little_endian 1.0\nelement vertex {n}\nproperty float x\n"
+                  f"property float y\nproperty float z\nend_header\n".encode())
+        for c in range(copies):
+            angle, scale = rng.uniform(0, 2 * np.pi), rng.uniform(0.8, 1.0)
+            rot = np.array([[np.cos(angle), -np.sin(angle), 0], [np.sin(angle), np.cos(angle), 0], [0, 0, 1]])
+            # bunny00's up axis is y: the turn is about y
+            rot = rot[[0, 2, 1]][:, [0, 2, 1]]
+            place = np.array([c % side, 0.0, c // side]) * 2 * width
+            w = v @ rot.T * scale + place
+            a, b, cc = (w[f[:, k]] for k in range(3))
+            area = 0.5 * np.linalg.norm(np.cross(b - a, cc - a), axis=1)
+            for start in range(0, int(per[c]), 1 << 21):
+                m = min(1 << 21, int(per[c]) - start)
+                tri = rng.choice(len(f), m, p=area / area.sum())
+                s, t = rng.random(m), rng.random(m)
+                flip = s + t > 1
+                s[flip], t[flip] = 1 - s[flip], 1 - t[flip]
+                p = a[tri] + s[:, None] * (b[tri] - a[tri]) + t[:, None] * (cc[tri] - a[tri])
+                out.write(p.astype("<f4").tobytes())
+
+
 def read_mesh_ply(path):
     """Vertices and triangles of a binary little-endian PLY the CLI wrote."""
     with open(path, "rb") as f:
@@ -160,6 +194,52 @@ def kill_check(cloud, resolution, tile_points, workers):
     return same, restarted, time.perf_counter() - t
 
 
+def mesh_topology(faces, vertex_count):
+    """(components, genus of a closed mesh) by Euler's formula per the whole."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    f = faces.astype(np.int64)
+    graph = coo_matrix((np.ones(2 * len(f)), (np.concatenate([f[:, 0], f[:, 1]]), np.concatenate([f[:, 1], f[:, 2]]))),
+                       shape=(vertex_count, vertex_count))
+    _, label = connected_components(graph, directed=False)
+    pieces = len(np.unique(label[np.unique(f)]))
+    e = np.sort(np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]]), axis=1)
+    edges = len(np.unique(e[:, 0] * vertex_count + e[:, 1]))
+    chi = vertex_count - edges + len(f)
+    return pieces, (2 * pieces - chi) // 2
+
+
+def scale_run(out, points, side, resolution, tile_points, workers):
+    """The scale point: a mosaic of side² bunnies, tiled only (one process could not hold
+    it), the mesh streamed to a PLY by the driver; then the seams and topology of that file."""
+    import gmpu.dask as gd
+    cloud = out / f"mosaic_{points}.ply"
+    if not cloud.exists():
+        subprocess.run([sys.executable, "-c", f"import sys; sys.path.insert(0, {str(Path(__file__).parent)!r}); "
+                        f"import dask_bench; dask_bench.write_mosaic({str(cloud)!r}, {points}, {side})"], check=True)
+    mesh_path = out / f"mosaic_{points}_mesh.ply"
+    with local_client(workers) as client:
+        stats = {}
+        t = time.perf_counter()
+        counts = gd.reconstruct(str(cloud), client, tile_points=tile_points, resolution=resolution, stats=stats,
+                                threads=1, output=str(mesh_path))
+        wall = time.perf_counter() - t
+        peaks = sorted(client.run(lambda: resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024).values())
+    driver = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+    v, f, _ = read_mesh_ply(mesh_path)
+    boundary, nonmanifold = edge_problems(f)
+    pieces, genus = mesh_topology(f, len(v))
+    row = {"scale_points": points, "scale_bunnies": side * side, "scale_tiles": stats["tiles"],
+           "scale_seconds": round(wall, 2), "scale_worker_peak_bytes": peaks, "scale_driver_peak_bytes": driver,
+           "scale_triangles": counts["faces"], "scale_boundary_edges": boundary, "scale_nonmanifold_edges": nonmanifold,
+           "scale_components": pieces, "scale_genus_total": genus, "scale_tile_seconds": stats["tile_seconds"]}
+    print(f"scale:   {points} points ({side * side} bunnies), {stats['tiles']} tiles: {wall:.1f} s wall, workers "
+          f"{[round(p / 1e9, 2) for p in peaks]} GB peak, driver {driver / 1e9:.2f} GB (streamed); "
+          f"{counts['faces']} triangles; boundary {boundary}, non-manifold {nonmanifold}, components {pieces} "
+          f"(bunnies {side * side}), genus sum {genus}", flush=True)
+    return row
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--build", default="build")
@@ -169,9 +249,20 @@ def main():
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--kill-check", type=int, default=0,
                     help="points of a cloud on which a worker is killed mid-run (0: no check)")
+    ap.add_argument("--scale-points", type=int, default=0,
+                    help="points of the scale point (a mosaic of bunnies, tiled only; 0: none)")
+    ap.add_argument("--scale-side", type=int, default=10, help="the mosaic is side × side bunnies")
+    ap.add_argument("--scale-resolution", type=int, default=0,
+                    help="grid cubes along the mosaic's longest side (0: 107 per bunny, the untiled default)")
+    ap.add_argument("--scale-only", action="store_true", help="run the scale point alone")
     args = ap.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    if args.scale_only:
+        row = scale_run(out, args.scale_points, args.scale_side, args.scale_resolution or 107 * 2 * args.scale_side,
+                        args.tile_points, args.workers)
+        (out / "dask_scale.json").write_text(json.dumps(row, indent=1))
+        return 0
     cloud = out / f"bunny_{args.points}.ply"
     if not cloud.exists():
         # In a child process, so that this one's peak memory is the driver's alone.
@@ -182,6 +273,7 @@ def main():
     print(f"untiled: {u_wall:.1f} s wall, {u_peak / 1e9:.2f} GB peak, resolution {resolution}", flush=True)
     mesh, t_wall, peaks, driver, stats = tiled_run(cloud, resolution, args.tile_points, args.workers)
     boundary, nonmanifold = edge_problems(np.asarray(mesh.faces))
+    components, genus = mesh_topology(np.asarray(mesh.faces), len(mesh.vertices))
     uv, uf, un = read_mesh_ply(untiled_mesh)
     diagonal = float(np.linalg.norm(uv.max(0) - uv.min(0)))
     cham, agree = compare(np.asarray(mesh.vertices), np.asarray(mesh.normals), uv, un)
@@ -189,14 +281,14 @@ def main():
         "points": args.points, "tiles": stats["tiles"], "tile_points": args.tile_points, "workers": args.workers,
         "untiled_seconds": round(u_wall, 2), "untiled_peak_bytes": u_peak,
         "tiled_seconds": round(t_wall, 2), "worker_peak_bytes": peaks, "driver_peak_bytes": driver,
-        "boundary_edges": boundary, "nonmanifold_edges": nonmanifold, "components": mesh.components,
-        "genus": mesh.genus, "chamfer_share_of_diagonal": cham / diagonal, "orientation_agreement": agree,
+        "boundary_edges": boundary, "nonmanifold_edges": nonmanifold, "components": components,
+        "genus": genus, "chamfer_share_of_diagonal": cham / diagonal, "orientation_agreement": agree,
         "tiled_volume_positive": bool(mesh.volume > 0), "resolution": resolution,
-        "phase1_seconds": round(stats["phase1_seconds"], 2),
+        "phase1_seconds": round(stats["phase1_seconds"], 2), "tile_seconds": stats["tile_seconds"],
     }
     print(f"tiled:   {t_wall:.1f} s wall, workers {[round(p / 1e9, 2) for p in peaks]} GB peak, driver "
           f"{driver / 1e9:.2f} GB; {stats['tiles']} tiles; boundary {boundary}, non-manifold {nonmanifold}, "
-          f"components {mesh.components}, genus {mesh.genus}; Chamfer {100 * cham / diagonal:.4f} % of the diagonal; "
+          f"components {components}, genus {genus}; Chamfer {100 * cham / diagonal:.4f} % of the diagonal; "
           f"orientation agreement {100 * agree:.3f} %", flush=True)
     if args.kill_check:
         small = out / f"bunny_{args.kill_check}.ply"
@@ -206,6 +298,9 @@ def main():
         row.update(kill_check_points=args.kill_check, kill_check_identical=same, kill_check_worker_restarted=restarted)
         print(f"killed a worker mid-run on {args.kill_check} points: worker restarted {restarted}, mesh identical "
               f"{same} ({seconds:.0f} s for both runs)", flush=True)
+    if args.scale_points:
+        row.update(scale_run(out, args.scale_points, args.scale_side,
+                             args.scale_resolution or 107 * 2 * args.scale_side, args.tile_points, args.workers))
     (out / "dask.json").write_text(json.dumps(row, indent=1))
     return 0
 

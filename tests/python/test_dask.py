@@ -180,3 +180,64 @@ def test_every_tile_reversed_is_turned_outward(cloud, untiled, client):
     assert mesh.volume > 0
     assert components_and_genus(mesh.faces, len(mesh.vertices)) == \
         components_and_genus(untiled[0].faces, len(untiled[0].vertices))
+
+
+def test_pieces_of_one_tile_take_their_own_flips():
+    """A tile whose margin cuts a patch off its main piece may orient the two each its own
+    way: piece 1 of tile 0 disagrees with tile 1 where piece 0 agrees, so only flips per
+    piece reconcile them."""
+    up, down = np.array([[0, 0, 1]] * 2, np.float32), np.array([[0, 0, -1]] * 2, np.float32)
+    summaries = [
+        {"pieces": 2, "shared": np.array([1, 2, 3, 4]), "shared_pieces": np.array([0, 0, 1, 1]),
+         "normals": np.concatenate([up, down])},
+        {"pieces": 1, "shared": np.array([1, 2, 3, 4]), "shared_pieces": np.zeros(4, np.int64),
+         "normals": np.concatenate([up, up])},
+    ]
+    flip, group = gd.reconcile_signs(summaries)
+    assert len(flip) == 3 and len(set(group)) == 1
+    assert flip[0] == flip[2] and flip[1] == -flip[2]
+
+
+def test_a_piece_split_across_tiles_is_judged_whole():
+    """Two halves of one closed piece, each under the share alone, are kept together; a
+    bubble is dropped."""
+    outlines = [
+        {"sizes": np.array([1000, 15]), "keys": np.array([7], np.uint64), "component": np.array([1])},
+        {"sizes": np.array([15, 1000, 3]), "keys": np.array([7], np.uint64), "component": np.array([0])},
+    ]
+    small = gd.small_components(outlines, 0.01)  # share: 20.3 triangles of 2033
+    assert small[0].tolist() == [False, False]
+    assert small[1].tolist() == [False, False, True]
+
+
+def _two_pieces():
+    """Two tiles' triangles sharing the edge of lattice keys 11, 12 on their common face."""
+    a = {"vertices": np.array([[0., 0, 0], [1, 0, 0], [1, 1, 0]]), "triangles": np.array([[0, 1, 2]], np.uint32),
+         "keys": np.array([10, 11, 12], np.uint64), "on_box": np.array([False, True, True]),
+         "normal_sums": np.array([[0., 0, 1], [0, 0, 1], [0, 0, 1]])}
+    b = {"vertices": np.array([[1., 1, 0], [1, 0, 0], [2, 0, 1]]), "triangles": np.array([[1, 0, 2]], np.uint32),
+         "keys": np.array([12, 11, 13], np.uint64), "on_box": np.array([True, True, False]),
+         "normal_sums": np.array([[1., 0, 0], [1, 0, 0], [1, 0, 0]])}
+    return [a, b]
+
+
+def test_streamed_mesh_is_welded_and_appears_whole(tmp_path):
+    mesh = gd.assemble(iter(_two_pieces()), gd._MemorySink())
+    assert len(mesh.vertices) == 4 and mesh.faces.tolist() == [[0, 1, 2], [1, 2, 3]]
+    assert np.allclose(mesh.normals[1], [2 ** -0.5, 0, 2 ** -0.5])  # summed over both tiles
+    out = tmp_path / "m.ply"
+    assert gd.assemble(iter(_two_pieces()), gd.PlyStreamSink(str(out))) == {"vertices": 4, "faces": 2}
+    assert np.allclose(gmpu.read_points(out).positions, mesh.vertices)
+    assert np.allclose(gmpu.read_points(out).normals, mesh.normals, atol=1e-6)
+
+    def failing():
+        yield _two_pieces()[0]
+        raise RuntimeError("worker lost for good")
+    sink = gd.PlyStreamSink(str(tmp_path / "broken.ply"))
+    with pytest.raises(RuntimeError):
+        try:
+            gd.assemble(failing(), sink)
+        except BaseException:
+            sink.abort()
+            raise
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.ply"]  # no half-written file, no parts

@@ -9,16 +9,22 @@ How (issue 17):
 
 1. **Tiles.** The cloud's box is covered by one global grid (cubes of side ``cell``, cut in
    blocks of 8³ cubes) and split kd-wise, on block boundaries, into tiles of about
-   ``tile_points`` points. A tile task reads only its points — its box plus an overlap
-   margin — fits and orients a gmpu surface on them, finds its *band* (the blocks it owns
-   within ``band_cells`` cubes of a point) and evaluates f at the corners its band blocks own
-   (gmpu_surface_evaluate_grid: corners 8·b .. 8·b + 7, so every corner has one owner).
+   ``tile_points`` points. A file's points are sorted once, by chunk tasks, into per-tile
+   files (each tile's box plus an overlap margin of ``margin_cells`` cubes, at least the
+   band plus two cubes); a tile task reads its own, fits and orients a gmpu surface on them,
+   finds its *band* (the blocks it owns within ``band_cells`` cubes of a point) and
+   evaluates f at the corners its band blocks own (gmpu_surface_evaluate_grid: corners
+   8·b .. 8·b + 7, so every corner has one owner). The tile's points fall in *pieces*
+   (occupied cubes, 26-connected): the margin may cut a patch off the tile's main piece,
+   and orientation may turn it its own way, so every band corner is tagged with the piece
+   of the nearest occupied cube.
 2. **Global orientation.** Each tile also returns the oriented normals of a fixed subsample
-   of its overlap points. Two tiles agree when their normals on the points both hold point
-   the same way; a maximum spanning tree of the tile graph on |agreement| fixes one flip per
-   tile (a tile's own orientation of an open patch is a guess). Then the outward pass: per
-   connected group of tiles, the band corners next to the far region that touches the
-   grid's edge must be outside (f < 0); if most are not, the group is flipped.
+   of its overlap points. Two pieces (of two tiles) agree when their normals on the points
+   both hold point the same way; a maximum spanning tree of the piece graph on |agreement|
+   fixes one flip per piece (a tile's own orientation of an open patch is a guess). Then
+   the outward pass: per connected group of pieces, the band corners next to the far region
+   that touches the grid's edge must be outside (f < 0); if most are not, the group is
+   flipped.
 3. **Far regions.** Blocks outside every tile's band form regions (6-connected); the one
    at the grid's edge is outside, each enclosed one (the inside of a thick solid) takes the
    sign most band corners beside it have. A corner touching a far block takes its region's
@@ -27,6 +33,11 @@ How (issue 17):
    of its +x/+y/+z neighbour blocks from the tiles that own them, and marches its blocks
    (gmpu_grid_polygonize). Shared corners have one value, so both sides cut a shared face
    identically; vertices are keyed by lattice edge and welded by key into one closed mesh.
+5. **Assembly.** Closed pieces of the mesh under ``min_component_share`` of the triangles
+   (bubbles of the far field) are found across tiles (joined by their tile-face vertices)
+   and dropped on the workers; the driver then takes the tiles' meshes one at a time, in
+   tile order, remembering only the vertices on tile faces, and streams them to a PLY
+   (``output=``) that is renamed into place when complete.
 
 Every task is a pure function of its inputs, so a worker lost mid-run is recomputed by Dask
 and the mesh is the same.
@@ -139,6 +150,81 @@ class _Source:
         step = max(1, self.count // wanted)
         return np.concatenate([p for _, p in self.chunks(step)]) if step > 1 else \
             np.concatenate([p for _, p in self.chunks()])
+
+
+class _TileFiles:
+    """A tile's points as the sorting pass left them: files of (global index, x, y, z)."""
+
+    def __init__(self, paths: Sequence[str], count: int):
+        self.paths, self.count = list(paths), count
+
+    def select(self, lo: np.ndarray, hi: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+        parts = [np.load(p) for p in self.paths]
+        if not parts:
+            return np.zeros(0, np.int64), np.zeros((0, 3))
+        rows = np.concatenate(parts)
+        xyz = np.stack([rows["x"], rows["y"], rows["z"]], axis=1).astype(np.float64)
+        keep = np.all((xyz >= lo) & (xyz < hi), axis=1)
+        return rows["index"][keep], xyz[keep]
+
+
+def _sort_chunk(source: "_Source", plan: "TilePlan", start: int, directory: str) -> List[Tuple[int, str]]:
+    """One pass of the points [start, start + chunk): each point written to the file of every
+    tile whose box plus margin holds it (tile t, chunk c: t<t>_<c>.npy). Returns (tile,
+    file) per file written. Each tile then reads only its own points, instead of every tile
+    scanning the whole cloud."""
+    g, m = plan.grid, plan.margin
+    if source.layout:
+        rows = source._mapped()[start:start + _CHUNK]
+        xyz = np.stack([rows["x"], rows["y"], rows["z"]], axis=1)
+    else:
+        xyz = source.array[start:start + _CHUNK]
+    p = xyz.astype(np.float64)
+    size = BLOCK * g.cell
+    block = np.floor((p - g.origin) / size).astype(np.int64)
+    owner = _tile_of_block(plan)
+    lo = np.array([bl for bl, _ in plan.tiles]) * size + g.origin - m
+    hi = np.array([bh for _, bh in plan.tiles]) * size + g.origin + m
+    reach = int(np.ceil(m / size))
+    pairs = []
+    for dz in range(-reach, reach + 1):
+        for dy in range(-reach, reach + 1):
+            for dx in range(-reach, reach + 1):
+                b = block + np.array([dx, dy, dz])
+                ok = np.all((b >= 0) & (b < g.blocks), axis=1)
+                t = np.where(ok, owner[g.block_key(np.where(ok[:, None], b, 0))], -1)
+                inside = (t >= 0) & np.all((p >= lo[t]) & (p < hi[t]), axis=1)
+                pairs.append(np.flatnonzero(inside) * len(plan.tiles) + t[inside])
+    code = np.unique(np.concatenate(pairs))
+    point, tile = code // len(plan.tiles), code % len(plan.tiles)
+    dtype = np.dtype([("index", "<i8"), ("x", xyz.dtype), ("y", xyz.dtype), ("z", xyz.dtype)])
+    written = []
+    order = np.argsort(tile, kind="stable")
+    tile, point = tile[order], point[order]
+    bounds = np.flatnonzero(np.diff(tile)) + 1
+    for a, b in zip(np.r_[0, bounds], np.r_[bounds, len(tile)]):
+        if a == b:
+            continue
+        t = int(tile[a])
+        out = np.empty(b - a, dtype)
+        out["index"] = start + point[a:b]
+        for d, name in enumerate("xyz"):
+            out[name] = xyz[point[a:b], d]
+        path = os.path.join(directory, f"t{t}_{start}.npy")
+        with open(path + ".part", "wb") as f:  # renamed whole: a rerun after a lost worker rewrites it
+            np.save(f, out)
+        os.replace(path + ".part", path)
+        written.append((t, path))
+    return written
+
+
+def _tile_of_block(plan: "TilePlan") -> np.ndarray:
+    owner = np.full(int(np.prod(plan.grid.blocks)), -1, np.int64)
+    nb = plan.grid.blocks
+    o = owner.reshape(nb[2], nb[1], nb[0])
+    for t, (bl, bh) in enumerate(plan.tiles):
+        o[bl[2]:bh[2], bl[1]:bh[1], bl[0]:bh[0]] = t
+    return owner
 
 
 # ---- the plan: grid and tiles -------------------------------------------------------------
@@ -256,56 +342,139 @@ def _band_blocks(points: np.ndarray, grid: Grid, radius: float, lo: np.ndarray, 
     return keys
 
 
+def _pieces(xyz: np.ndarray, grid: Grid) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The tile's points in pieces: occupied grid cubes joined across faces, edges and corners
+    (26-connected). Returns the occupied cubes' centres, their piece, and each point's piece.
+    A tile sees patches its margin cuts off from the rest, and orientation may turn each one
+    its own way: each piece gets its own flip in the reconciliation."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    cube = np.floor((xyz - grid.origin) / grid.cell).astype(np.int64)
+    n = grid.cells + 3  # cube keys with room for the ±1 neighbours
+    key = (cube[:, 0] + 1) + n[0] * ((cube[:, 1] + 1) + n[1] * (cube[:, 2] + 1))
+    cubes, point_cube = np.unique(key, return_inverse=True)
+    rows, cols = [np.arange(len(cubes))], [np.arange(len(cubes))]
+    for dz in (-1, 0, 1):
+        for dy in (-1, 0, 1):
+            for dx in (-1, 0, 1):
+                if (dz, dy, dx) <= (0, 0, 0):
+                    continue  # each pair once
+                other = cubes + dx + n[0] * (dy + n[1] * dz)
+                pos = np.clip(np.searchsorted(cubes, other), 0, len(cubes) - 1)
+                hit = cubes[pos] == other
+                rows.append(np.flatnonzero(hit))
+                cols.append(pos[hit])
+    r, c = np.concatenate(rows), np.concatenate(cols)
+    _, label = connected_components(coo_matrix((np.ones(len(r), np.int8), (r, c)), shape=(len(cubes),) * 2),
+                                    directed=False)
+    x = cubes % n[0] - 1
+    y = cubes // n[0] % n[1] - 1
+    z = cubes // (n[0] * n[1]) - 1
+    centres = grid.origin + (np.stack([x, y, z], axis=1) + 0.5) * grid.cell
+    return centres, label.astype(np.int64), label[point_cube].astype(np.int64)
+
+
+def _corner_pieces(centres: np.ndarray, cube_piece: np.ndarray, grid: Grid, blocks: np.ndarray) -> np.ndarray:
+    """Per owned corner of the blocks [block, 512], the piece of the nearest occupied cube."""
+    from scipy.spatial import cKDTree
+    ijk = np.stack(np.meshgrid(np.arange(BLOCK), np.arange(BLOCK), np.arange(BLOCK), indexing="ij"),
+                   axis=-1).reshape(-1, 3)[:, ::-1]  # x fastest: [k, j, i] → (i, j, k)
+    corners = grid.origin + (blocks[:, None, :] * BLOCK + ijk[None]) * grid.cell
+    # Approximate nearest (within 1.5× the nearest distance): pieces are at least a cube apart.
+    _, nearest = cKDTree(centres).query(corners.reshape(-1, 3), eps=0.5)
+    return cube_piece[nearest].reshape(len(blocks), _OWNED)
+
+
 def _tile_surface(source: Any, plan: TilePlan, tile: int, params: Dict[str, Any], reverse: bool = False) -> Dict[str, Any]:
-    """Phase 1 of a tile: its points, surface, band and corner values, and the normals of its
-    overlap sample. `reverse` (tests) turns the tile's surface over, as if its own
-    orientation had guessed wrong."""
-    if not isinstance(source, _Source):
+    """Phase 1 of a tile: its points, surface, band and corner values, the piece of each
+    corner, and the normals of its overlap sample. `reverse` (tests) turns the tile's surface
+    over, as if its own orientation had guessed wrong."""
+    if not isinstance(source, (_Source, _TileFiles)):
         source = _Source(array=source)
+    clock = time.perf_counter()
+    times: Dict[str, float] = {}
+
+    def lap(name):
+        nonlocal clock
+        now = time.perf_counter()
+        times[name] = now - clock
+        clock = now
+
     g = plan.grid
     bl, bh = plan.tiles[tile]
     own_lo = g.origin + bl * BLOCK * g.cell
     own_hi = g.origin + bh * BLOCK * g.cell
     idx, xyz = source.select(own_lo - plan.margin, own_hi + plan.margin)
+    lap("read")
     keys = _band_blocks(xyz, g, plan.band_radius, bl, bh)
-    out: Dict[str, Any] = {"tile": tile, "points": len(idx), "keys": keys}
+    out: Dict[str, Any] = {"tile": tile, "points": len(idx), "keys": keys, "times": times}
     if len(keys) == 0:
-        out.update(values=np.zeros((0, _OWNED), np.float32), faces=np.zeros((0, 6), np.int64),
-                   shared=np.zeros(0, np.int64), normals=np.zeros((0, 3), np.float32))
+        out.update(values=np.zeros((0, _OWNED), np.float32), labels=np.zeros((0, _OWNED), np.int32), pieces=0,
+                   faces=np.zeros((0, 4), np.int64), shared=np.zeros(0, np.int64),
+                   shared_pieces=np.zeros(0, np.int64), normals=np.zeros((0, 3), np.float32))
         return out
-    with Surface(xyz, **params) as s:
-        s.fit()
-        s.orient()
-        values = _evaluate_grid(s, g, g.block_of_key(keys))
-        normals = s.normals
-    if reverse:
-        values, normals = -values, -normals
-    v = values.reshape(-1, BLOCK, BLOCK, BLOCK)  # [block, k, j, i]
-    sg = np.sign(v)
-    # Sign sums of the corner layer nearest each face (−x, +x, −y, +y, −z, +z): the votes of
-    # the far regions beside the block.
-    out["faces"] = np.stack([sg[:, :, :, 0].sum((1, 2)), sg[:, :, :, -1].sum((1, 2)),
-                             sg[:, :, 0, :].sum((1, 2)), sg[:, :, -1, :].sum((1, 2)),
-                             sg[:, 0, :, :].sum((1, 2)), sg[:, -1, :, :].sum((1, 2))], axis=1).astype(np.int64)
-    out["values"] = values.astype(np.float32)
+    centres, cube_piece, point_piece = _pieces(xyz, g)
+    pieces = int(cube_piece.max()) + 1
     # Overlap points: those some other tile holds too. A subsample fixed by global index, so
     # both tiles pick the same points.
     inner = np.all((xyz >= own_lo + plan.margin) & (xyz < own_hi - plan.margin), axis=1)
     stride = max(1, source.count // (len(plan.tiles) * _SHARED_SAMPLE))
-    shared = (~inner) & (idx % stride == 0)
+    shared = np.flatnonzero((~inner) & (idx % stride == 0))
     out["shared"] = idx[shared]
-    out["normals"] = normals[shared].astype(np.float32)
+    out["shared_pieces"] = point_piece[shared]
+    del idx, point_piece, inner
+    lap("pieces")
+    with Surface(xyz, **params) as s:
+        del xyz  # the surface holds its own copy: only it while fitting
+        s.fit()
+        lap("fit")
+        s.orient()
+        lap("orient")
+        blocks = g.block_of_key(keys)
+        values = _evaluate_grid(s, g, blocks)
+        lap("evaluate")
+        normals = s.normals[shared]
+    if reverse:
+        values, normals = -values, -normals
+    labels = _corner_pieces(centres, cube_piece, g, blocks) if pieces > 1 else np.zeros(values.shape, np.int32)
+    v = values.reshape(-1, BLOCK, BLOCK, BLOCK)  # [block, k, j, i]
+    lab = labels.reshape(-1, BLOCK, BLOCK, BLOCK)
+    sg = np.sign(v).astype(np.int64)
+    # Sign sums of the corner layer nearest each face (−x, +x, −y, +y, −z, +z), per piece:
+    # the votes of the far regions beside the block. Rows (block, face, piece, sum).
+    layers = [(sg[:, :, :, 0], lab[:, :, :, 0]), (sg[:, :, :, -1], lab[:, :, :, -1]),
+              (sg[:, :, 0, :], lab[:, :, 0, :]), (sg[:, :, -1, :], lab[:, :, -1, :]),
+              (sg[:, 0, :, :], lab[:, 0, :, :]), (sg[:, -1, :, :], lab[:, -1, :, :])]
+    rows = []
+    for f, (sign, piece) in enumerate(layers):
+        block = np.broadcast_to(np.arange(len(keys))[:, None, None], piece.shape)
+        code = block.reshape(-1) * pieces + piece.reshape(-1)
+        sums = np.bincount(code, weights=sign.reshape(-1), minlength=len(keys) * pieces)
+        hit = np.unique(code)
+        rows.append(np.stack([hit // pieces, np.full(len(hit), f), hit % pieces, sums[hit].astype(np.int64)], axis=1))
+    out["faces"] = np.concatenate(rows)
+    out["values"] = values.astype(np.float32)
+    # None: every corner in piece 0.
+    out["labels"] = labels.astype(np.int16 if pieces < 1 << 15 else np.int32) if pieces > 1 else None
+    out["pieces"] = pieces
+    out["normals"] = normals.astype(np.float32)
+    lap("votes")
     return out
 
 
 def _summary(result: Dict[str, Any]) -> Dict[str, Any]:
-    return {k: v for k, v in result.items() if k != "values"}
+    return {k: v for k, v in result.items() if k not in ("values", "labels")}
 
 
-def _take(result: Dict[str, Any], keys: np.ndarray, flip: int) -> Tuple[np.ndarray, np.ndarray]:
-    """The corner values of some of a tile's blocks, signed by the tile's flip."""
-    pos = np.searchsorted(result["keys"], keys)
-    return keys, result["values"][pos] * np.float32(flip)
+def _signed(result: Dict[str, Any], pos: Any, flips: np.ndarray) -> np.ndarray:
+    """The corner values of some of a tile's blocks, each corner signed by its piece's flip."""
+    if result["labels"] is None:
+        return result["values"][pos] * np.float32(flips[0])
+    return result["values"][pos] * flips.astype(np.float32)[result["labels"][pos]]
+
+
+def _take(result: Dict[str, Any], keys: np.ndarray, flips: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
+    return keys, _signed(result, np.searchsorted(result["keys"], keys), flips)
 
 
 # Corner c (0..8) of a block touches the blocks at offsets TOUCH[c] (−1, 0, +1 → 0, 1, 2).
@@ -355,15 +524,15 @@ def _corner_values(keys: np.ndarray, grid: Grid, avail_keys: np.ndarray, avail_v
     return corners
 
 
-def _march(own: Dict[str, Any], flip: int, foreign: Sequence[Tuple[np.ndarray, np.ndarray]], far: np.ndarray,
-           grid: Grid) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _march(own: Dict[str, Any], flips: np.ndarray, foreign: Sequence[Tuple[np.ndarray, np.ndarray]], far: np.ndarray,
+           grid: Grid, box: Tuple[np.ndarray, np.ndarray]) -> Dict[str, Any]:
     """Phase 2 of a tile: its blocks marched with every corner known. Returns vertices,
     triangles and the vertices' lattice-edge keys."""
     keys = own["keys"]
     if len(keys) == 0:
-        return np.zeros((0, 3)), np.zeros((0, 3), np.uint32), np.zeros(0, np.uint64)
+        return _piece(np.zeros((0, 3)), np.zeros((0, 3), np.uint32), np.zeros(0, np.uint64), grid, box)
     avail_keys = np.concatenate([keys] + [k for k, _ in foreign])
-    avail_values = np.concatenate([own["values"] * np.float32(flip)] + [v for _, v in foreign])
+    avail_values = np.concatenate([_signed(own, slice(None), flips)] + [v for _, v in foreign])
     order = np.argsort(avail_keys, kind="stable")
     corners = _corner_values(keys, grid, avail_keys[order], avail_values[order], far)
     blocks = np.ascontiguousarray(grid.block_of_key(keys), dtype=np.int64)
@@ -377,32 +546,120 @@ def _march(own: Dict[str, Any], flip: int, foreign: Sequence[Tuple[np.ndarray, n
     m = ffi.gc(out[0], lib.gmpu_mesh_destroy)
     nv, nt = lib.gmpu_mesh_vertex_count(m), lib.gmpu_mesh_triangle_count(m)
     if nv == 0:
-        return np.zeros((0, 3)), np.zeros((0, 3), np.uint32), np.zeros(0, np.uint64)
+        return _piece(np.zeros((0, 3)), np.zeros((0, 3), np.uint32), np.zeros(0, np.uint64), grid, box)
     vertices = np.frombuffer(ffi.buffer(lib.gmpu_mesh_vertices(m), 24 * nv), np.float64).reshape(nv, 3).copy()
     triangles = np.frombuffer(ffi.buffer(lib.gmpu_mesh_triangles(m), 12 * nt), np.uint32).reshape(nt, 3).copy()
     edge_keys = np.frombuffer(ffi.buffer(lib.gmpu_mesh_grid_keys(m), 8 * nv), np.uint64).copy()
-    return vertices, triangles, edge_keys
+    return _piece(vertices, triangles, edge_keys, grid, box)
+
+
+def _piece(vertices: np.ndarray, triangles: np.ndarray, keys: np.ndarray, grid: Grid,
+           box: Tuple[np.ndarray, np.ndarray]) -> Dict[str, Any]:
+    """A tile's mesh as the assembly takes it: which vertices lie on the faces of the tile's
+    box (the only ones another tile can also make: welded by key), their area-weighted
+    normal sums (summed across tiles for the face vertices) and its connected pieces."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    corner = (keys // np.uint64(8)).astype(np.int64)
+    steps = (keys % np.uint64(8)).astype(np.int64) + 1  # the edge's axes, one bit each
+    n0, n1 = grid.cells[0] + 1, grid.cells[1] + 1
+    at = [corner % n0, corner // n0 % n1, corner // (n0 * n1)]
+    lo, hi = box[0] * BLOCK, box[1] * BLOCK
+    on_box = np.zeros(len(keys), bool)
+    for d in range(3):
+        flat = (steps >> d & 1) == 0  # the edge does not leave the plane across axis d
+        on_box |= flat & ((at[d] == lo[d]) | (at[d] == hi[d]))
+    t = triangles.astype(np.int64)
+    v = vertices[t] if len(t) else np.zeros((0, 3, 3))
+    area = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
+    sums = np.zeros_like(vertices)
+    for d in range(3):
+        for c in range(3):
+            sums[:, d] += np.bincount(t[:, c], weights=area[:, d], minlength=len(vertices))
+    component = np.zeros(len(t), np.int64)
+    vertex_component = np.zeros(len(vertices), np.int64)
+    sizes = np.zeros(0, np.int64)
+    if len(t):
+        edges = (np.concatenate([t[:, 0], t[:, 1]]), np.concatenate([t[:, 1], t[:, 2]]))
+        graph = coo_matrix((np.ones(2 * len(t)), edges), shape=(len(vertices),) * 2)
+        count, vertex_component = connected_components(graph, directed=False)
+        component = vertex_component[t[:, 0]]
+        sizes = np.bincount(component, minlength=count)
+    return {"vertices": vertices, "triangles": triangles, "keys": keys, "on_box": on_box, "normal_sums": sums,
+            "component": component, "sizes": sizes, "vertex_component": vertex_component}
+
+
+def _outline(piece: Dict[str, Any]) -> Dict[str, np.ndarray]:
+    """What the driver needs to find the mesh's connected pieces across tiles: triangles per
+    connected piece of this tile's mesh, and the keys (and pieces) of its tile-face vertices."""
+    return {"sizes": piece["sizes"], "keys": piece["keys"][piece["on_box"]],
+            "component": piece["vertex_component"][piece["on_box"]]}
+
+
+def small_components(outlines: Sequence[Dict[str, np.ndarray]], min_share: float) -> List[np.ndarray]:
+    """Per tile piece, which of its connected pieces belong to a connected piece of the whole
+    mesh with fewer than `min_share` of the triangles (bubbles of the far field): joined
+    across tiles where they share a tile-face vertex."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    offsets = np.cumsum([0] + [len(o["sizes"]) for o in outlines])
+    n = int(offsets[-1])
+    keys = np.concatenate([o["keys"] for o in outlines]) if outlines else np.zeros(0, np.uint64)
+    node = np.concatenate([offsets[i] + o["component"] for i, o in enumerate(outlines)]) if outlines else \
+        np.zeros(0, np.int64)
+    order = np.argsort(keys, kind="stable")
+    keys, node = keys[order], node[order]
+    same = np.flatnonzero(keys[1:] == keys[:-1])
+    graph = coo_matrix((np.ones(len(same)), (node[same], node[same + 1])), shape=(n, n))
+    _, label = connected_components(graph, directed=False)
+    sizes = np.concatenate([o["sizes"] for o in outlines]) if outlines else np.zeros(0, np.int64)
+    total = np.bincount(label, weights=sizes, minlength=label.max() + 1 if n else 0)
+    small = total[label] < min_share * sizes.sum()
+    return [small[offsets[i]:offsets[i + 1]] for i in range(len(outlines))]
+
+
+def _pruned(piece: Dict[str, Any], small: np.ndarray) -> Dict[str, Any]:
+    """The piece without its `small` connected pieces and the vertices only they used."""
+    if not small.any():
+        return piece
+    keep = ~small[piece["component"]]
+    t = piece["triangles"][keep].astype(np.int64)
+    used = np.unique(t)
+    remap = np.full(len(piece["vertices"]), -1, np.int64)
+    remap[used] = np.arange(len(used))
+    out = {k: piece[k][used] for k in ("vertices", "keys", "on_box", "normal_sums")}
+    out["triangles"] = remap[t].astype(np.uint32)
+    return out
 
 
 # ---- the driver's steps -------------------------------------------------------------------
 
 
+def piece_offsets(summaries: Sequence[Dict[str, Any]]) -> np.ndarray:
+    """Node numbers: tile t's piece p is node offsets[t] + p (the last entry: the node count)."""
+    return np.cumsum([0] + [int(s["pieces"]) for s in summaries])
+
+
 def reconcile_signs(summaries: Sequence[Dict[str, Any]]) -> Tuple[np.ndarray, np.ndarray]:
-    """One flip (±1) per tile so that tiles agree on their shared points, and the group
-    (connected part of the tile graph) of each tile. Maximum spanning tree on |agreement|."""
-    n = len(summaries)
-    edges = []
-    for a in range(n):
-        for b in range(a + 1, n):
-            sa, sb = summaries[a]["shared"], summaries[b]["shared"]
-            common, ia, ib = np.intersect1d(sa, sb, assume_unique=True, return_indices=True)
-            if len(common) == 0:
-                continue
-            agree = float(np.einsum("ij,ij->", summaries[a]["normals"][ia].astype(np.float64),
-                                    summaries[b]["normals"][ib].astype(np.float64)))
-            if agree != 0:
-                edges.append((abs(agree), a, b, 1 if agree > 0 else -1))
-    edges.sort(key=lambda e: -e[0])
+    """One flip (±1) per tile piece so that the pieces agree on the overlap points they
+    share, and the group (connected part of the piece graph) of each piece. Maximum
+    spanning tree on |agreement|."""
+    offsets = piece_offsets(summaries)
+    n = int(offsets[-1])
+    ids = np.concatenate([s["shared"] for s in summaries])
+    node = np.concatenate([offsets[t] + s["shared_pieces"] for t, s in enumerate(summaries)])
+    tile = np.concatenate([np.full(len(s["shared"]), t) for t, s in enumerate(summaries)])
+    normals = np.concatenate([s["normals"] for s in summaries]).astype(np.float64)
+    order = np.lexsort((tile, ids))
+    ids, node, tile, normals = ids[order], node[order], tile[order], normals[order]
+    # A point held by several tiles: each holder paired with the next one.
+    same = np.flatnonzero((ids[1:] == ids[:-1]) & (tile[1:] != tile[:-1]))
+    a, b = node[same], node[same + 1]
+    dot = np.einsum("ij,ij->i", normals[same], normals[same + 1])
+    pair, inverse = np.unique(np.minimum(a, b) * n + np.maximum(a, b), return_inverse=True)
+    agree = np.bincount(inverse, weights=dot, minlength=len(pair)) if len(pair) else np.zeros(0)
+    edges = sorted(((abs(w), int(k // n), int(k % n), 1 if w > 0 else -1) for k, w in zip(pair, agree) if w != 0),
+                   key=lambda e: -e[0])
     parent = list(range(n))
 
     def root(x):
@@ -443,9 +700,9 @@ _FACE_STEPS = np.array([[-1, 0, 0], [1, 0, 0], [0, -1, 0], [0, 1, 0], [0, 0, -1]
 
 def far_signs(grid: Grid, summaries: Sequence[Dict[str, Any]], flip: np.ndarray,
               group: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The outward pass and the far regions' signs. Returns the flips (groups whose band is
-    mostly inside next to the outer region turned over), the block grid's region labels and
-    each region's sign (index 0: band)."""
+    """The outward pass and the far regions' signs. Returns the flips per piece (groups
+    whose band is mostly inside next to the outer region turned over), the block grid's
+    region labels and each region's sign (index 0: band)."""
     from scipy import ndimage
     nb = grid.blocks
     band = np.zeros(int(np.prod(nb)), bool)
@@ -454,30 +711,25 @@ def far_signs(grid: Grid, summaries: Sequence[Dict[str, Any]], flip: np.ndarray,
     labels, count = ndimage.label(~band.reshape(nb[2], nb[1], nb[0]))
     labels = labels.reshape(-1)
     outer = labels[0]
+    offsets = piece_offsets(summaries)
     flip = flip.copy()
-    votes = np.zeros(count + 1, np.float64)
-    outer_votes = np.zeros(int(group.max()) + 1 if len(group) else 0, np.float64)
-    per_tile = []
+    # Per face-vote row (block, face, piece, sum): the far region beside it and its node.
+    rows = []
     for t, s in enumerate(summaries):
-        if len(s["keys"]) == 0:
-            per_tile.append(None)
+        f = s["faces"]
+        if len(f) == 0:
             continue
-        b = grid.block_of_key(s["keys"])
-        lab = np.zeros((len(b), 6), np.int64)
-        for f in range(6):
-            c = b + _FACE_STEPS[f]
-            lab[:, f] = labels[grid.block_key(c)]
-        per_tile.append(lab)
-        outer_votes[group[t]] += float((s["faces"] * (lab == outer)).sum()) * flip[t]
-    for g in range(len(outer_votes)):
-        if outer_votes[g] > 0:  # the group's band is mostly inside next to the outside
-            flip[group == g] *= -1
-    for t, s in enumerate(summaries):
-        lab = per_tile[t]
-        if lab is None:
-            continue
-        np.add.at(votes, lab.reshape(-1), (s["faces"] * flip[t]).reshape(-1))
-    sign = np.where(votes > 0, 1, -1).astype(np.int8)
+        beside = grid.block_of_key(s["keys"][f[:, 0]]) + _FACE_STEPS[f[:, 1]]
+        rows.append((labels[grid.block_key(beside)], offsets[t] + f[:, 2], f[:, 3].astype(np.float64)))
+    region = np.concatenate([r for r, _, _ in rows]) if rows else np.zeros(0, np.int64)
+    node = np.concatenate([n for _, n, _ in rows]) if rows else np.zeros(0, np.int64)
+    votes = np.concatenate([v for _, _, v in rows]) if rows else np.zeros(0)
+    groups = int(group.max()) + 1 if len(group) else 0
+    outer_votes = np.bincount(group[node], weights=votes * flip[node] * (region == outer), minlength=groups)
+    for g in np.flatnonzero(outer_votes > 0):  # the group's band is mostly inside next to the outside
+        flip[group == g] *= -1
+    region_votes = np.bincount(region, weights=votes * flip[node], minlength=count + 1)
+    sign = np.where(region_votes > 0, 1, -1).astype(np.int8)
     sign[0] = 0
     sign[outer] = -1
     return flip, labels, sign
@@ -494,50 +746,128 @@ def _neighbourhood(grid: Grid, keys: np.ndarray, labels: np.ndarray, sign: np.nd
     return far
 
 
-def weld(pieces: Sequence[Tuple[np.ndarray, np.ndarray, np.ndarray]]) -> Tuple[np.ndarray, np.ndarray]:
-    """One vertex per lattice edge across the tiles' meshes."""
-    pieces = [p for p in pieces if len(p[1])]
-    if not pieces:
-        return np.zeros((0, 3)), np.zeros((0, 3), np.uint32)
-    keys = np.concatenate([p[2] for p in pieces])
-    verts = np.concatenate([p[0] for p in pieces])
-    offsets = np.cumsum([0] + [len(p[0]) for p in pieces])
-    tris = np.concatenate([p[1].astype(np.int64) + offsets[i] for i, p in enumerate(pieces)])
-    unique, first, inverse = np.unique(keys, return_index=True, return_inverse=True)
-    return verts[first], inverse[tris].astype(np.uint32)
+class _MemorySink:
+    """The welded mesh kept in memory (gmpu.Mesh)."""
+
+    def __init__(self):
+        self.vertices, self.normals, self.faces = [], [], []
+
+    def add(self, vertices: np.ndarray, normals: np.ndarray, faces: np.ndarray) -> None:
+        self.vertices.append(vertices)
+        self.normals.append(normals)
+        self.faces.append(faces)
+
+    def finish(self, index: np.ndarray, normals: np.ndarray) -> Mesh:
+        v = np.concatenate(self.vertices) if self.vertices else np.zeros((0, 3))
+        n = np.concatenate(self.normals) if self.normals else np.zeros((0, 3))
+        f = np.concatenate(self.faces) if self.faces else np.zeros((0, 3), np.uint32)
+        n[index] = normals
+        return Mesh(v, f, n)
+
+    def abort(self) -> None:
+        pass
 
 
-def drop_small_components(vertices: np.ndarray, faces: np.ndarray, min_share: float) -> Tuple[np.ndarray, np.ndarray]:
-    """Closed pieces with fewer than `min_share` of the triangles (bubbles of the far field)
-    are dropped; unused vertices go with them."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-    if len(faces) == 0:
-        return vertices, faces
-    f = faces.astype(np.int64)
-    rows = np.concatenate([f[:, 0], f[:, 1]])
-    cols = np.concatenate([f[:, 1], f[:, 2]])
-    graph = coo_matrix((np.ones(len(rows)), (rows, cols)), shape=(len(vertices), len(vertices)))
-    _, label = connected_components(graph, directed=False)
-    tri_label = label[f[:, 0]]
-    sizes = np.bincount(tri_label)
-    keep = sizes[tri_label] >= min_share * len(faces)
-    f = f[keep]
-    used = np.unique(f)
-    remap = np.full(len(vertices), -1, np.int64)
-    remap[used] = np.arange(len(used))
-    return vertices[used], remap[f].astype(np.uint32)
+_VERTEX = np.dtype([("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("nx", "<f4"), ("ny", "<f4"), ("nz", "<f4")])
+_FACE = np.dtype([("n", "u1"), ("i", "<i4", (3,))])
 
 
-def vertex_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """Area-weighted unit vertex normals (outward for counter-clockwise faces)."""
-    v = vertices[faces.astype(np.int64)]
-    n = np.cross(v[:, 1] - v[:, 0], v[:, 2] - v[:, 0])
-    acc = np.zeros_like(vertices)
-    for c in range(3):
-        np.add.at(acc, faces[:, c].astype(np.int64), n)
-    length = np.linalg.norm(acc, axis=1, keepdims=True)
-    return acc / np.where(length > 0, length, 1)
+class PlyStreamSink:
+    """The welded mesh written to a binary PLY as the tiles' pieces arrive: vertices and
+    faces go to two scratch files beside the output; `finish` fixes the normals of the
+    vertices on tile faces (summed across tiles), writes the header and renames the whole
+    into place, so the output is either absent or complete."""
+
+    def __init__(self, path: str):
+        self.path = os.fspath(path)
+        self.parts = [self.path + ".vertices.part", self.path + ".faces.part", self.path + ".part"]
+        self.vfile, self.ffile = open(self.parts[0], "wb"), open(self.parts[1], "wb")
+        self.vertex_count = self.face_count = 0
+
+    def add(self, vertices: np.ndarray, normals: np.ndarray, faces: np.ndarray) -> None:
+        rec = np.empty(len(vertices), _VERTEX)
+        for name, col in zip(("x", "y", "z"), vertices.T):
+            rec[name] = col
+        for name, col in zip(("nx", "ny", "nz"), normals.T):
+            rec[name] = col
+        self.vfile.write(rec.tobytes())
+        fr = np.empty(len(faces), _FACE)
+        fr["n"] = 3
+        fr["i"] = faces
+        self.ffile.write(fr.tobytes())
+        self.vertex_count += len(vertices)
+        self.face_count += len(faces)
+
+    def finish(self, index: np.ndarray, normals: np.ndarray) -> Dict[str, int]:
+        self.vfile.close()
+        self.ffile.close()
+        if len(index):
+            rec = np.memmap(self.parts[0], dtype=_VERTEX, mode="r+")
+            for name, col in zip(("nx", "ny", "nz"), normals.T):
+                rec[name][index] = col
+            rec.flush()
+            del rec
+        header = (f"ply\nformat binary_little_endian 1.0\nelement vertex {self.vertex_count}\n"
+                  "property float x\nproperty float y\nproperty float z\n"
+                  "property float nx\nproperty float ny\nproperty float nz\n"
+                  f"element face {self.face_count}\nproperty list uchar int vertex_indices\nend_header\n")
+        import shutil
+        with open(self.parts[2], "wb") as out:
+            out.write(header.encode("ascii"))
+            for part in self.parts[:2]:
+                with open(part, "rb") as f:
+                    shutil.copyfileobj(f, out, 1 << 24)
+                os.remove(part)
+        os.replace(self.parts[2], self.path)
+        return {"vertices": self.vertex_count, "faces": self.face_count}
+
+    def abort(self) -> None:
+        for f in (self.vfile, self.ffile):
+            f.close()
+        for part in self.parts:
+            if os.path.exists(part):
+                os.remove(part)
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    length = np.linalg.norm(v, axis=1, keepdims=True)
+    return v / np.where(length > 0, length, 1)
+
+
+def assemble(pieces: Any, sink: Any) -> Any:
+    """Welds the tiles' pieces, in the given order, into `sink` one piece at a time. Only
+    the vertices on tile faces are remembered (lattice-edge key → index and normal sum): the
+    others are final when their piece arrives."""
+    seen: Dict[int, int] = {}
+    face_index: List[int] = []
+    face_sums: List[np.ndarray] = []
+    count = 0
+    for piece in pieces:
+        nv = len(piece["vertices"])
+        if nv == 0:
+            continue
+        index = np.empty(nv, np.int64)
+        new = ~piece["on_box"]
+        for i in np.flatnonzero(piece["on_box"]):
+            key = int(piece["keys"][i])
+            slot = seen.get(key)
+            if slot is None:
+                seen[key] = len(face_index)
+                face_index.append(-1)
+                face_sums.append(piece["normal_sums"][i].copy())
+                new[i] = True
+            else:
+                face_sums[slot] += piece["normal_sums"][i]
+                index[i] = face_index[slot]
+        fresh = np.flatnonzero(new)
+        index[fresh] = count + np.arange(len(fresh))
+        for i in np.flatnonzero(piece["on_box"] & new):
+            face_index[seen[int(piece["keys"][i])]] = int(index[i])
+        count += len(fresh)
+        sink.add(piece["vertices"][fresh], _unit(piece["normal_sums"][fresh]),
+                 index[piece["triangles"].astype(np.int64)].astype(np.uint32))
+    sums = np.array(face_sums).reshape(-1, 3)
+    return sink.finish(np.array(face_index, np.int64), _unit(sums))
 
 
 # ---- the entry point ----------------------------------------------------------------------
@@ -545,20 +875,26 @@ def vertex_normals(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
 
 def reconstruct(path_or_array: Any, client: Any = None, *, tile_points: int = 2_000_000, resolution: int = 0,
                 band_cells: float = 3.0, margin_cells: float = 16.0, min_component_share: float = 0.001,
-                reconcile: bool = True, stats: Optional[Dict[str, Any]] = None, _flip_tiles: Sequence[int] = (),
-                **params: Any) -> Mesh:
+                reconcile: bool = True, stats: Optional[Dict[str, Any]] = None, output: Optional[str] = None,
+                scratch: Optional[str] = None,
+                _flip_tiles: Sequence[int] = (), **params: Any) -> Any:
     """The closed, outward-oriented mesh of a cloud (a PLY/XYZ path — binary little-endian
     PLY is memory-mapped — or an n×3 array), reconstructed in tiles of about `tile_points`
     points on the Dask `client` (None: the current client, else a local one made for the
     call). `resolution`: grid cubes along the longest side (0: 1.5 point spacings a cube);
     `band_cells`: how far from the points the field is evaluated, in cubes; `margin_cells`:
     each tile's overlap with its neighbours, in cubes; closed pieces with fewer than
-    `min_component_share` of the triangles are dropped. Other keywords are gmpu.Surface
+    `min_component_share` of the triangles are dropped. `output`: a .ply
+    path the mesh is streamed to (the driver holds one tile's piece at a time; the file
+    appears complete or not at all), and the call returns its vertex and face counts
+    instead of the mesh. `scratch`: where the sorting pass of a file's points leaves each
+    tile's points (default: the temporary directory; on a cluster, a directory every
+    worker sees), removed at the end. Other keywords are gmpu.Surface
     parameters for every tile. `stats`, if a dict, receives the plan's figures.
     `reconcile=False` keeps every tile's own orientation (for comparison: an open patch's
     orientation is a guess); `_flip_tiles` (tests) turns those tiles' surfaces over."""
     from distributed import Client, get_client
-    own_client = None
+    own_client = scratch_dir = None
     if client is None:
         try:
             client = get_client()
@@ -583,16 +919,29 @@ def reconstruct(path_or_array: Any, client: Any = None, *, tile_points: int = 2_
                           resolution=resolution, band_cells=band_cells, margin_cells=margin_cells)
         g = plan.grid
         # Tasks get the points as a shared future (an array) or the path (each maps the file).
-        data = client.scatter(source.array, broadcast=False) if source.layout is None else source
-        phase1 = [client.submit(_tile_surface, data, plan, t, params, t in _flip_tiles, pure=False)
+        if source.layout is None:  # an array: a shared future
+            data = client.scatter(source.array, broadcast=False)
+            tile_data = [data] * len(plan.tiles)
+        else:  # a file: one sorting pass, then each tile reads its own points
+            import tempfile
+            scratch_dir = tempfile.mkdtemp(prefix="gmpu-dask-", dir=scratch)
+            files: Dict[int, List[str]] = {t: [] for t in range(len(plan.tiles))}
+            for written in client.gather([client.submit(_sort_chunk, source, plan, start, scratch_dir, pure=False)
+                                          for start in range(0, source.count, _CHUNK)]):
+                for t, path in written:
+                    files[t].append(path)
+            tile_data = [_TileFiles(files[t], source.count) for t in range(len(plan.tiles))]
+        phase1 = [client.submit(_tile_surface, tile_data[t], plan, t, params, t in _flip_tiles, pure=False)
                   for t in range(len(plan.tiles))]
         summaries = client.gather([client.submit(_summary, f) for f in phase1])
         t1 = time.perf_counter()
         if reconcile:
             flip, group = reconcile_signs(summaries)
         else:  # every tile as it oriented itself, one outward pass for all
-            flip, group = np.ones(len(summaries), np.int64), np.zeros(len(summaries), np.int64)
+            nodes = int(piece_offsets(summaries)[-1])
+            flip, group = np.ones(nodes, np.int64), np.zeros(nodes, np.int64)
         flip, labels, sign = far_signs(g, summaries, flip, group)
+        offsets = piece_offsets(summaries)
         # Who owns each band block, for the neighbours' corner layers.
         all_keys = np.concatenate([s["keys"] for s in summaries])
         owner = np.concatenate([np.full(len(s["keys"]), t) for t, s in enumerate(summaries)])
@@ -612,22 +961,40 @@ def reconstruct(path_or_array: Any, client: Any = None, *, tile_points: int = 2_
             pos = np.clip(np.searchsorted(all_keys, need), 0, len(all_keys) - 1)
             found = all_keys[pos] == need
             need, who = need[found], owner[pos[found]]
-            foreign = [client.submit(_take, phase1[u], need[who == u], int(flip[u]))
+            foreign = [client.submit(_take, phase1[u], need[who == u], flip[offsets[u]:offsets[u + 1]])
                        for u in np.unique(who) if u != t]
             far = _neighbourhood(g, keys, labels, sign)
-            phase2.append(client.submit(_march, phase1[t], int(flip[t]), foreign, far, g))
-        pieces = client.gather(phase2)
-        del phase1, phase2
-        vertices, faces = weld(pieces)
-        vertices, faces = drop_small_components(vertices, faces, min_component_share)
+            phase2.append(client.submit(_march, phase1[t], flip[offsets[t]:offsets[t + 1]], foreign, far, g,
+                                        plan.tiles[t]))
+        del phase1
+        small = small_components(client.gather([client.submit(_outline, f) for f in phase2]), min_component_share)
+        pruned = [client.submit(_pruned, f, sm) for f, sm in zip(phase2, small)]
+        del phase2
+
+        def arriving():  # in tile order (the same mesh every run), one piece held at a time
+            for i in range(len(pruned)):
+                piece = pruned[i].result()
+                pruned[i] = None
+                yield piece
+        sink = PlyStreamSink(output) if output is not None else _MemorySink()
+        try:
+            result = assemble(arriving(), sink)
+        except BaseException:
+            sink.abort()
+            raise
         if stats is not None:
             stats.update(tiles=len(plan.tiles), cell=g.cell, grid_cells=g.cells.tolist(), flips=flip.tolist(),
                          groups=int(group.max()) + 1 if len(group) else 0,
                          tile_points=[int(s["points"]) for s in summaries],
-                         band_blocks=int(len(all_keys)), phase1_seconds=t1 - t0,
+                         band_blocks=int(len(all_keys)), phase1_seconds=t1 - t0, pieces=int(offsets[-1]),
+                         tile_seconds={k: round(sum(s["times"].get(k, 0.0) for s in summaries), 3)
+                                       for k in ("read", "fit", "orient", "evaluate", "pieces", "votes")},
                          seconds=time.perf_counter() - t0)
-        return Mesh(vertices, faces, vertex_normals(vertices, faces))
+        return result
     finally:
+        if scratch_dir is not None:
+            import shutil
+            shutil.rmtree(scratch_dir, ignore_errors=True)
         if own_client is not None:
             own_client.close()
 
@@ -655,10 +1022,13 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
         client = Client(cluster)
     try:
         stats: Dict[str, Any] = {}
-        mesh = reconstruct(args.input, client, tile_points=args.tile_points, resolution=args.resolution,
-                           stats=stats, threads=args.threads_per_worker)
-        mesh.write(args.output)
-        print(f"{len(mesh.faces)} triangles, {stats['tiles']} tiles, {stats['seconds']:.1f} s -> {args.output}")
+        streamed = args.output.lower().endswith(".ply")
+        result = reconstruct(args.input, client, tile_points=args.tile_points, resolution=args.resolution,
+                             stats=stats, threads=args.threads_per_worker, output=args.output if streamed else None)
+        if not streamed:
+            result.write(args.output)
+        triangles = result["faces"] if streamed else len(result.faces)
+        print(f"{triangles} triangles, {stats['tiles']} tiles, {stats['seconds']:.1f} s -> {args.output}")
     finally:
         client.close()
         if cluster is not None:
