@@ -4,18 +4,22 @@
 // cubes. In each cube the face segments join into loops, and each loop becomes a disk of
 // triangles whose diagonals never run along a cube face (a face edge then belongs to the
 // two cubes sharing the face and to no other): closed and edge-manifold wherever the grid's
-// boundary has one sign, like marching tetrahedra, with about a third of the triangles
-// (no vertices on the cubes' diagonals).
+// boundary has one sign, with no vertices on the cubes' diagonals.
 #pragma once
 
 #include <cstdint>
 
-#include "mesh/marching_tetrahedra.hpp"
-
 namespace gmpu::mc {
 
-using mt::Edge;  // cube edges here all run along one axis (directions 0, 1 and 3)
-using mt::edge_direction;
+// Corner c of a cube is at offset (c & 1, c >> 1 & 1, c >> 2 & 1). An edge joins two
+// corners, from the lower to the upper one; a cube's edges run along one axis each.
+struct Edge {
+    uint8_t from, to;
+};
+
+// Direction of an edge: to − from as the bit pattern zyx, minus one (0, 1 or 3 for x, y, z);
+// with the lower corner's grid index it names a grid edge, the key vertices weld by.
+inline int edge_direction(const Edge &e) { return (e.to ^ e.from) - 1; }
 
 // The surface in one cube for a sign pattern (bit c set: corner c is inside, f > 0):
 // triangles (three vertices as cube edges) and quads (loops of four, split along the
@@ -28,8 +32,9 @@ struct CubeCase {
 };
 const CubeCase &cube_case(int inside_mask);
 
-// As mt::march_block: for each corner of each triangle of the n³ cubes, in order,
-// emit(i, j, k, edge) names the cube and the cube edge its vertex lies on. A quad q is
+// Marches the n³ cubes of a block whose corner values value(i, j, k) are given for i, j, k
+// in 0..n (the one-process polygonizer and the tiles' march share it, so tiled and untiled
+// meshes are cut alike): for each corner of each triangle, in order, emit(i, j, k, edge) names the cube and the cube edge its vertex lies on. A quad q is
 // split along q[0]–q[2] when split_02(i, j, k, q) says so, else along q[1]–q[3]: the
 // choice stays inside the cube, so neighbouring cubes (and tiles) need not agree on it.
 template <class Value, class Emit, class Split>

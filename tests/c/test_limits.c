@@ -120,7 +120,7 @@ static void test_max_triangles(void **state) {
     assert_true(tris > 1000);
     gmpu_mesh_destroy(m);
 
-    /* The cap counts the triangles marching tetrahedra makes, before pieces that no input
+    /* The cap counts the triangles marching cubes makes, before pieces that no input
      * point supports are dropped, so its exact boundary is not observable from here: half
      * the final count fails, 1.5 times it succeeds. Neither discards the orientation. */
     assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_MAX_TRIANGLES, (double)(tris + tris / 2)));

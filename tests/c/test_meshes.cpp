@@ -297,8 +297,7 @@ void level_of_detail_keeps_the_topology_of_the_full_surface(void **) {
 
 // The grid follows the point density: four times the points of the same torus give a finer
 // grid (the octree's leaves alone give both the same), with a mesh of at most 2 triangles
-// per point (marching cubes: marching tetrahedra made about 2.5 on the same grids); both
-// closed, edge-manifold and outward.
+// per point; both closed, edge-manifold and outward.
 void mesh_size_follows_the_points(void **) {
     const Torus torus(Vec3(0, 0, 0), 1.0, 0.35);
     double resolution[2];

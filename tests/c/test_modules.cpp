@@ -1,6 +1,6 @@
 // Unit tests of the C++ modules, one group per concept, each against an answer known in
 // advance: quadric algebra, the three fits, the robust Taubin error, the noise estimate,
-// belief propagation, the marching-tetrahedra table (closed surfaces for any sign field),
+// belief propagation, the marching-cubes table (closed surfaces for any sign field),
 // the winding number, point-set validation, mesh clean-up and the parallel loop.
 #include <algorithm>
 #include <atomic>
@@ -37,7 +37,6 @@
 #include "implicit/mpu_function.hpp"
 #include "implicit/winding_field.hpp"
 #include "mesh/marching_cubes.hpp"
-#include "mesh/marching_tetrahedra.hpp"
 #include "mesh/mesh_cleanup.hpp"
 #include "orient/belief_propagation.hpp"
 
@@ -518,75 +517,6 @@ void bp_data_term_breaks_ties_only(void **) {
     assert_int_equal(solve_bp(g, 0.01, 5).label[1], -1);
 }
 
-// ---- marching tetrahedra --------------------------------------------------------------
-
-void tetrahedra_cases_separate_signs(void **) {
-    // Every triangle of every case cuts edges joining an inside and an outside corner, and
-    // is wound with its normal towards the outside corners.
-    for (int t = 0; t < mt::kTetrahedra; ++t)
-        for (int mask = 0; mask < 16; ++mask) {
-            const mt::TetCase &c = mt::tet_case(t, mask);
-            int inside = __builtin_popcount(unsigned(mask));
-            assert_int_equal(c.triangle_count, inside == 0 || inside == 4 ? 0 : (inside == 2 ? 2 : 1));
-            for (int k = 0; k < c.triangle_count; ++k)
-                for (const mt::Edge &e : c.triangles[k]) {
-                    int a = -1, b = -1;
-                    for (int q = 0; q < 4; ++q) {
-                        if (mt::kTetCorners[t][q] == e.from) a = q;
-                        if (mt::kTetCorners[t][q] == e.to) b = q;
-                    }
-                    assert_true(a >= 0 && b >= 0);
-                    assert_true(((mask >> a) & 1) != ((mask >> b) & 1));
-                }
-        }
-}
-
-void marching_tetrahedra_closes_any_sign_field(void **) {
-    // Random values on a 7³ grid whose border is all negative: the union of every cube's
-    // tetrahedra cases, welded by grid edge, is a closed, consistently wound surface.
-    const int n = 7;
-    std::mt19937_64 rng(11);
-    std::uniform_real_distribution<double> u(-1, 1);
-    std::vector<double> v(n * n * n);
-    auto id = [&](int i, int j, int k) { return i + n * (j + n * k); };
-    for (int k = 0; k < n; ++k)
-        for (int j = 0; j < n; ++j)
-            for (int i = 0; i < n; ++i) {
-                bool border = i == 0 || j == 0 || k == 0 || i == n - 1 || j == n - 1 || k == n - 1;
-                v[size_t(id(i, j, k))] = border ? -1 : u(rng);
-            }
-    std::map<uint64_t, uint32_t> vertex;
-    std::vector<uint32_t> tris;
-    for (int k = 0; k + 1 < n; ++k)
-        for (int j = 0; j + 1 < n; ++j)
-            for (int i = 0; i + 1 < n; ++i)
-                for (int t = 0; t < mt::kTetrahedra; ++t) {
-                    int mask = 0;
-                    for (int q = 0; q < 4; ++q) {
-                        int c = mt::kTetCorners[t][q];
-                        if (v[size_t(id(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1)))] > 0) mask |= 1 << q;
-                    }
-                    const mt::TetCase &tc = mt::tet_case(t, mask);
-                    for (int tri = 0; tri < tc.triangle_count; ++tri)
-                        for (const mt::Edge &e : tc.triangles[tri]) {
-                            int c = e.from;
-                            uint64_t key = uint64_t(id(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1))) * 8 +
-                                           uint64_t(mt::edge_direction(e));
-                            auto it = vertex.emplace(key, uint32_t(vertex.size())).first;
-                            tris.push_back(it->second);
-                        }
-                }
-    assert_true(tris.size() > 30);
-    std::map<std::pair<uint32_t, uint32_t>, int> directed;
-    for (size_t t = 0; t < tris.size(); t += 3)
-        for (int e = 0; e < 3; ++e) ++directed[{tris[t + size_t(e)], tris[t + size_t((e + 1) % 3)]}];
-    for (const auto &[edge, count] : directed) {
-        assert_int_equal(count, 1);  // no directed edge twice: consistent winding
-        auto twin = directed.find({edge.second, edge.first});
-        assert_true(twin != directed.end());  // every edge has its opposite: closed
-    }
-}
-
 // ---- marching cubes ---------------------------------------------------------------------
 
 // Marches an n³-corner field with marching cubes, welding vertices by grid edge; returns
@@ -693,7 +623,7 @@ void marching_cubes_closes_any_sign_field(void **) {
 
 void marching_cubes_sphere_needs_few_triangles(void **) {
     // About 2 triangles per cube the surface crosses: at most 4 per h² of area on a sphere
-    // (marching tetrahedra's Kuhn split makes about 9).
+    // (a split of each cube into tetrahedra makes about 9).
     const int n = 41;
     const double r = 15.3, c = 20.1;
     std::vector<double> v(size_t(n) * n * n);
@@ -891,8 +821,6 @@ int main(void) {
         cmocka_unit_test(winding_number_of_a_sampled_sphere),
         cmocka_unit_test(bp_follows_clamped_evidence),
         cmocka_unit_test(bp_data_term_breaks_ties_only),
-        cmocka_unit_test(tetrahedra_cases_separate_signs),
-        cmocka_unit_test(marching_tetrahedra_closes_any_sign_field),
         cmocka_unit_test(cube_cases_cut_sign_changes_outward),
         cmocka_unit_test(marching_cubes_closes_any_sign_field),
         cmocka_unit_test(marching_cubes_sphere_needs_few_triangles),

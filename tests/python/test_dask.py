@@ -136,7 +136,7 @@ def test_a_reversed_tile_is_reconciled(cloud, untiled, client):
         components_and_genus(untiled[0].faces, len(untiled[0].vertices))
     assert mesh.volume > 0
     assert abs(mesh.volume / untiled[0].volume - 1) < 0.01
-    # Marching tetrahedra closes any consistent set of corner values, so the reversed tile
+    # Marching cubes closes any consistent set of corner values, so the reversed tile
     # does not open the mesh: it turns its part inside out, with handles where it meets
     # the other tiles.
     broken = gd.reconstruct(cloud, client, tile_points=TILE_POINTS, resolution=untiled[1], threads=1,
