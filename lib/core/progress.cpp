@@ -19,6 +19,10 @@ const char *stage_name(gmpu_stage stage) {
 void Progress::report_overall(double fraction, bool force) {
     Shared &s = *shared_;
     if (!s.fn || cancelled()) return;
+    // Fraction 1 is the stage's final report alone (forced, once the result is ready): a step
+    // ending on the stage's last slice would otherwise say 1 before it, and callers that act
+    // on 1 would act twice.
+    if (!force && fraction >= 1.0) return;
     auto now = std::chrono::steady_clock::now();
     if (!force && now - s.last_report < kReportInterval) return;
     s.last_report = now;
