@@ -53,9 +53,13 @@ struct Table {
     }
 
     void build(int mask) {
-        // The face segments, each from the crossing where the face's cycle (counter-clockwise
-        // seen from outside the cube) enters the inside to the next crossing where it leaves:
-        // that pairs each inside corner of an alternating face with its own two crossings.
+        // The face segments, traced around the outside (f ≤ 0) corners: each runs from the
+        // crossing where the face's cycle (counter-clockwise seen from outside the cube)
+        // enters an outside corner to the next crossing where it leaves. That pairs each
+        // outside corner of an alternating face with its own two crossings, so the face's two
+        // inside corners stay joined: a solid part thinner than a cube, whose inside corners
+        // touch only across faces' diagonals, stays one piece. The loops so traced run
+        // clockwise seen from the inside, and are reversed.
         int next[kEdges];
         for (int &e : next) e = -1;
         for (int d = 0; d < 3; ++d)
@@ -64,11 +68,11 @@ struct Table {
                 int q[4] = {0, 1 << u, 1 << u | 1 << v, 1 << v};  // counter-clockwise seen from +d
                 if (s == 0) std::swap(q[1], q[3]);
                 for (int &c : q) c |= s << d;
-                auto in = [&](int i) { return mask >> q[i & 3] & 1; };
+                auto out = [&](int i) { return !(mask >> q[i & 3] & 1); };
                 for (int i = 0; i < 4; ++i) {
-                    if (in(i) || !in(i + 1)) continue;  // not an entry
+                    if (out(i) || !out(i + 1)) continue;  // not an entry
                     int j = i + 1;
-                    while (!(in(j) && !in(j + 1))) ++j;  // the next exit
+                    while (!(out(j) && !out(j + 1))) ++j;  // the next exit
                     next[edges.index[q[i]][q[(i + 1) & 3]]] = edges.index[q[j & 3]][q[(j + 1) & 3]];
                 }
             }
@@ -78,6 +82,7 @@ struct Table {
             if (next[start] < 0 || used[start]) continue;
             std::vector<Edge> loop;
             for (int e = start; !used[e]; e = next[e]) used[e] = true, loop.push_back(edges.edge[e]);
+            std::reverse(loop.begin(), loop.end());
             // A quad's two diagonals both cross the cube's inside (its opposite vertices
             // never share a face): the march picks one.
             if (loop.size() == 4 && !share_face(loop[0], loop[2]) && !share_face(loop[1], loop[3]) &&

@@ -1,7 +1,7 @@
 // Marching cubes with one ambiguity rule everywhere: on a face whose corners alternate in
-// sign, the inside (f > 0) corners are kept apart. The rule reads the face's four signs
-// only, so the two cubes sharing a face cut it the same way and the surface closes across
-// cubes. In each cube the face segments join into loops, and each loop becomes a disk of
+// sign, the inside (f > 0) corners are joined and the outside ones kept apart. The rule
+// reads the face's four signs only, so the two cubes sharing a face cut it the same way and
+// the surface closes across cubes. In each cube the face segments join into loops, and each loop becomes a disk of
 // triangles whose diagonals never run along a cube face (a face edge then belongs to the
 // two cubes sharing the face and to no other): closed and edge-manifold wherever the grid's
 // boundary has one sign, with no vertices on the cubes' diagonals.

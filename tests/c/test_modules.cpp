@@ -7,6 +7,7 @@
 #include <cmath>
 #include <chrono>
 #include <map>
+#include <functional>
 #include <mutex>
 #include <set>
 
@@ -621,6 +622,27 @@ void marching_cubes_closes_any_sign_field(void **) {
     }
 }
 
+void marching_cubes_keep_a_thin_solid_whole(void **) {
+    // A solid one corner thick running diagonally (inside corners (i, i, k) only): each
+    // column touches the next across faces' diagonals alone. Joining inside corners on such
+    // faces makes it one closed piece; keeping them apart would cut it into its 4 columns.
+    const int n = 8;
+    auto id = [&](int i, int j, int k) { return i + n * (j + n * k); };
+    std::vector<double> v(size_t(n) * n * n, -1.0);
+    for (int i = 2; i <= 5; ++i)
+        for (int k = 2; k <= 5; ++k) v[size_t(id(i, i, k))] = 1.0;
+    const std::vector<uint32_t> tris = march_cubes(v, n);
+    assert_closed_manifold(tris);
+    std::vector<uint32_t> parent(tris.size());
+    for (uint32_t i = 0; i < parent.size(); ++i) parent[i] = i;
+    std::function<uint32_t(uint32_t)> root = [&](uint32_t a) { return parent[a] == a ? a : parent[a] = root(parent[a]); };
+    for (size_t t = 0; t < tris.size(); t += 3)
+        for (int e = 1; e < 3; ++e) parent[root(tris[t + size_t(e)])] = root(tris[t]);
+    std::set<uint32_t> pieces;
+    for (uint32_t vtx : tris) pieces.insert(root(vtx));
+    assert_int_equal(pieces.size(), 1);
+}
+
 void marching_cubes_sphere_needs_few_triangles(void **) {
     // About 2 triangles per cube the surface crosses: at most 4 per h² of area on a sphere
     // (a split of each cube into tetrahedra makes about 9).
@@ -689,6 +711,19 @@ void parallel_for_rethrows_and_cancels(void **) {
     cancelling.report(0.1, true);
     assert_true(cancelling.cancelled());
     assert_int_equal(status_of([&] { cancelling.throw_if_cancelled(); }), GMPU_ERROR_CANCELLED);
+}
+
+void only_the_final_report_says_done(void **) {
+    // A step ending on the stage's last slice reports its own end (not forced, with no
+    // report in the throttle interval before it); the stage's final report follows.
+    // Callers see fraction 1 once.
+    int done = 0;
+    Progress progress([](void *user, gmpu_stage, double f) -> int { *static_cast<int *>(user) += f >= 1.0; return 0; },
+                      &done, GMPU_STAGE_POLYGONIZE);
+    Progress last_step = progress.slice(0.95, 1.0);
+    last_step.report(1.0);  // the stage's first report: no throttle holds it back
+    progress.report(1.0, true);
+    assert_int_equal(done, 1);
 }
 
 void workers_are_reused_across_loops(void **) {
@@ -823,10 +858,12 @@ int main(void) {
         cmocka_unit_test(bp_data_term_breaks_ties_only),
         cmocka_unit_test(cube_cases_cut_sign_changes_outward),
         cmocka_unit_test(marching_cubes_closes_any_sign_field),
+        cmocka_unit_test(marching_cubes_keep_a_thin_solid_whole),
         cmocka_unit_test(marching_cubes_sphere_needs_few_triangles),
         cmocka_unit_test(unsupported_components_are_dropped),
         cmocka_unit_test(parallel_for_runs_each_index_once),
         cmocka_unit_test(parallel_for_rethrows_and_cancels),
+        cmocka_unit_test(only_the_final_report_says_done),
         cmocka_unit_test(workers_are_reused_across_loops),
         cmocka_unit_test(workers_take_none_of_the_hosts_signals),
         cmocka_unit_test(progress_slices_map_onto_the_stage),
