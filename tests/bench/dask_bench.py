@@ -38,22 +38,32 @@ def read_off(path):
     return v, f
 
 
+def write_surface_samples(out, rng, vertices, faces, n):
+    """n points area-uniform on a triangle mesh, appended to `out` as float32 xyz in chunks
+    (a 100M-point cloud never sits in memory whole)."""
+    a, b, c = (vertices[faces[:, k]] for k in range(3))
+    area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
+    for start in range(0, n, 1 << 21):
+        m = min(1 << 21, n - start)
+        tri = rng.choice(len(faces), m, p=area / area.sum())
+        s, t = rng.random(m), rng.random(m)
+        flip = s + t > 1
+        s[flip], t[flip] = 1 - s[flip], 1 - t[flip]
+        p = a[tri] + s[:, None] * (b[tri] - a[tri]) + t[:, None] * (c[tri] - a[tri])
+        out.write(p.astype("<f4").tobytes())
+
+
+def write_ply_header(out, n):
+    out.write(f"ply\nformat binary_little_endian 1.0\nelement vertex {n}\nproperty float x\n"
+              f"property float y\nproperty float z\nend_header\n".encode())
+
+
 def write_cloud(path, n, seed=17):
     v, f = read_off(REPO / "tests" / "data" / "meshes" / "bunny00.off")
     rng = np.random.default_rng(seed)
-    a, b, c = (v[f[:, k]] for k in range(3))
-    area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
     with open(path, "wb") as out:
-        out.write(f"ply\nformat binary_little_endian 1.0\nelement vertex {n}\nproperty float x\n"
-                  f"property float y\nproperty float z\nend_header\n".encode())
-        for start in range(0, n, 1 << 21):
-            m = min(1 << 21, n - start)
-            tri = rng.choice(len(f), m, p=area / area.sum())
-            s, t = rng.random(m), rng.random(m)
-            flip = s + t > 1
-            s[flip], t[flip] = 1 - s[flip], 1 - t[flip]
-            p = a[tri] + s[:, None] * (b[tri] - a[tri]) + t[:, None] * (c[tri] - a[tri])
-            out.write(p.astype("<f4").tobytes())
+        write_ply_header(out, n)
+        write_surface_samples(out, rng, v, f, n)
 
 
 def write_mosaic(path, n, side, seed=17):
@@ -69,25 +79,14 @@ def write_mosaic(path, n, side, seed=17):
     per = np.full(copies, n // copies)
     per[: n - per.sum()] += 1
     with open(path, "wb") as out:
-        out.write(f"ply\nformat binary_little_endian 1.0\nelement vertex {n}\nproperty float x\n"
-                  f"property float y\nproperty float z\nend_header\n".encode())
+        write_ply_header(out, n)
         for c in range(copies):
             angle, scale = rng.uniform(0, 2 * np.pi), rng.uniform(0.8, 1.0)
             rot = np.array([[np.cos(angle), -np.sin(angle), 0], [np.sin(angle), np.cos(angle), 0], [0, 0, 1]])
             # bunny00's up axis is y: the turn is about y
             rot = rot[[0, 2, 1]][:, [0, 2, 1]]
             place = np.array([c % side, 0.0, c // side]) * 2 * width
-            w = v @ rot.T * scale + place
-            a, b, cc = (w[f[:, k]] for k in range(3))
-            area = 0.5 * np.linalg.norm(np.cross(b - a, cc - a), axis=1)
-            for start in range(0, int(per[c]), 1 << 21):
-                m = min(1 << 21, int(per[c]) - start)
-                tri = rng.choice(len(f), m, p=area / area.sum())
-                s, t = rng.random(m), rng.random(m)
-                flip = s + t > 1
-                s[flip], t[flip] = 1 - s[flip], 1 - t[flip]
-                p = a[tri] + s[:, None] * (b[tri] - a[tri]) + t[:, None] * (cc[tri] - a[tri])
-                out.write(p.astype("<f4").tobytes())
+            write_surface_samples(out, rng, v @ rot.T * scale + place, f, int(per[c]))
 
 
 def read_mesh_ply(path):
