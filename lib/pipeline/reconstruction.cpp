@@ -90,11 +90,10 @@ Mesh Reconstruction::polygonize(const Params &params, int resolution, Progress &
     Workers &pool = workers(params.threads);
     progress.report(0.0, true);
     // The caller checks the mesh and makes the final report.
-    const bool wants_smooth = wants_smooth_surface(params, points, noise);
-    if (wants_smooth == bool(smooth)) return gmpu::polygonize(field(params.level), resolution, params, pool, progress, noise);
+    if (field_matches(params)) return gmpu::polygonize(field(params.level), resolution, params, pool, progress, noise);
     // The surface parameter changed since orient: solve or drop the smooth field first.
     Progress solve_progress = progress.slice(0.0, 0.3), march_progress = progress.slice(0.3, 1.0);
-    smooth = wants_smooth ? solve_smooth_surface(params, tree, points, measures, noise, solve_progress) : nullptr;
+    smooth = smooth ? nullptr : solve_smooth_surface(params, tree, points, measures, noise, solve_progress);
     return gmpu::polygonize(field(params.level), resolution, params, pool, march_progress, noise);
 }
 
