@@ -6,9 +6,12 @@ namespace gmpu {
 
 namespace {
 // A point's own normal and its nearest neighbours' (kAgreeNeighbours in all) agree when
-// their mean is at least this long; two sheets of a thin wall give a far shorter one.
+// their mean is at least this long; two sheets of a thin wall give a far shorter one
+// (about 0). A point whose own normal is flipped among eight right ones gives 7/9, so the
+// bar must sit below that for the field to correct it: here one more of the nine may
+// dissent (5/9).
 constexpr size_t kAgreeNeighbours = 9;
-constexpr double kAgreeing = 0.8;
+constexpr double kAgreeing = 0.5;
 
 Eigen::Vector3d normal_of(const std::vector<float> &normals, size_t i) {
     return Eigen::Vector3d(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);

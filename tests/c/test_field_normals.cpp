@@ -1,0 +1,138 @@
+// Output point normals from the smooth field (pipeline/smooth_normals.hpp): where a point's
+// own normal is flipped among right ones (what belief propagation leaves on noisy clouds
+// beside thin parts), the field that the many right normals shape turns it over; where
+// two sheets meet with opposite normals (a thin wall) the point keeps its own normal.
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "core/progress.hpp"
+#include "geometry/point_set.hpp"
+#include "implicit/point_measures.hpp"
+#include "implicit/smooth_field.hpp"
+#include "pipeline/smooth_normals.hpp"
+
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+extern "C" {
+#include <cmocka.h>
+}
+
+using Eigen::Vector3d;
+using namespace gmpu;
+
+namespace {
+
+constexpr size_t kPoints = 6000;
+constexpr double kRadius = 1.0;
+
+// Points on a sphere with Gaussian radial noise of `sigma`; `truth` receives the outward
+// normals (3 per point).
+PointSet noisy_sphere(double sigma, std::vector<float> &truth) {
+    std::mt19937 rng(17);
+    std::normal_distribution<double> gauss(0.0, 1.0);
+    std::vector<double> xyz;
+    truth.clear();
+    for (size_t i = 0; i < kPoints; ++i) {
+        Vector3d d(gauss(rng), gauss(rng), gauss(rng));
+        d.normalize();
+        const Vector3d p = (kRadius + sigma * gauss(rng)) * d;
+        for (int k = 0; k < 3; ++k) {
+            xyz.push_back(p[k]);
+            truth.push_back(float(d[k]));
+        }
+    }
+    return PointSet::from_array(xyz.data(), kPoints, 0, 15);
+}
+
+// The measures the smooth field reads, for the given normals: the same normals for the
+// field's splat, and area and trust from the 8th-neighbour distance (point_measures.cpp).
+PointMeasures measures_for(const PointSet &points, const std::vector<float> &normals) {
+    PointMeasures m;
+    m.normals = normals;
+    m.blend_normals = normals;
+    std::vector<uint32_t> idx;
+    std::vector<float> d2;
+    for (size_t i = 0; i < points.size(); ++i) {
+        points.nearest(points.point(i), 9, idx, d2);
+        const double rk = std::sqrt(double(d2.back()));
+        m.area.push_back(float(M_PI * rk * rk / 8.0));
+        m.trust_radius.push_back(float(1.5 * rk));
+        m.widest_trust = std::max(m.widest_trust, 1.5 * rk);
+    }
+    return m;
+}
+
+double dot(const std::vector<float> &a, const std::vector<float> &b, size_t i) {
+    return double(a[3 * i]) * b[3 * i] + double(a[3 * i + 1]) * b[3 * i + 1] + double(a[3 * i + 2]) * b[3 * i + 2];
+}
+
+// Isolated flipped normals (one point in sixteen, at random) on a noisy sphere: the field
+// points the right way at them, and the output follows it there.
+void isolated_flips_follow_the_field(void **) {
+    std::vector<float> truth;
+    const PointSet points = noisy_sphere(0.01, truth);
+    std::vector<float> normals(truth);
+    std::mt19937 rng(5);
+    std::vector<bool> flipped(points.size());
+    size_t flips = 0;
+    for (size_t i = 0; i < points.size(); ++i)
+        if ((flipped[i] = rng() % 16 == 0)) {
+            ++flips;
+            for (int k = 0; k < 3; ++k) normals[3 * i + size_t(k)] *= -1.0f;
+        }
+    const PointMeasures measures = measures_for(points, normals);
+    Progress quiet(nullptr, nullptr, GMPU_STAGE_ORIENT);
+    const double h = 1.0 / 64;
+    const SmoothField field(points, measures, h, 2.0 * h, 0.005, 1e9, quiet);
+    const std::vector<float> out = field_point_normals(field, points, measures, quiet);
+    size_t corrected = 0, right = 0;
+    for (size_t i = 0; i < points.size(); ++i) {
+        const bool ok = dot(out, truth, i) > 0.0;
+        right += ok;
+        corrected += flipped[i] && ok;
+    }
+    print_message("# %zu of %zu flipped normals corrected, %zu of %zu right\n", corrected, flips, right,
+                  points.size());
+    assert_true(corrected >= flips * 8 / 10);
+    assert_true(right >= points.size() * 99 / 100);
+}
+
+// Two parallel sheets a little apart with opposite normals (a thin wall): the field
+// merges them, so the points keep their own (right) normals.
+void thin_wall_keeps_its_normals(void **) {
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<double> u(-0.5, 0.5);
+    std::normal_distribution<double> gauss(0.0, 0.002);
+    std::vector<double> xyz;
+    std::vector<float> normals;
+    const size_t n = 6000;
+    const double gap = 0.012;
+    for (size_t i = 0; i < n; ++i) {
+        const double side = i % 2 ? 1.0 : -1.0;
+        xyz.insert(xyz.end(), {u(rng), u(rng), side * gap / 2 + gauss(rng)});
+        normals.insert(normals.end(), {0.0f, 0.0f, float(side)});
+    }
+    const PointSet points = PointSet::from_array(xyz.data(), n, 0, 15);
+    const PointMeasures measures = measures_for(points, normals);
+    Progress quiet(nullptr, nullptr, GMPU_STAGE_ORIENT);
+    const double h = 1.0 / 128;
+    const SmoothField field(points, measures, h, 2.0 * h, 0.002, 1e9, quiet);
+    const std::vector<float> out = field_point_normals(field, points, measures, quiet);
+    size_t right = 0;
+    for (size_t i = 0; i < n; ++i) right += dot(out, normals, i) > 0.0;
+    print_message("# thin wall: %zu of %zu normals right\n", right, n);
+    assert_true(right >= n * 985 / 1000);
+}
+
+}  // namespace
+
+int main() {
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(isolated_flips_follow_the_field),
+        cmocka_unit_test(thin_wall_keeps_its_normals),
+    };
+    return cmocka_run_group_tests(tests, nullptr, nullptr);
+}
