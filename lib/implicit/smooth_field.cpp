@@ -25,6 +25,10 @@ constexpr double kAgreeing = 0.3;
 // side, or after kMaxIterations.
 constexpr double kTolerance = 1e-4;
 constexpr int kMaxIterations = 300;
+// The outer field (over the whole box) stops after fewer: it starts from the band's
+// distances, it need only be settled near the band's edge, and far from the points only
+// its sign matters; most of the solve's time would otherwise go there.
+constexpr int kOuterIterations = 120;
 // Coarser levels of the cascade (each twice the previous step).
 constexpr int kCoarseLevels = 1;
 // The outer field's grid step, in fine steps: coarse enough to cover the whole box at a
@@ -319,8 +323,9 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
     Eigen::VectorXd z = inverse_diagonal.cwiseProduct(r), p = z;
     double rz = r.dot(z);
     const double target = kTolerance * kTolerance * std::max(rhs.squaredNorm(), 1e-300);
-    for (int it = 0; it < kMaxIterations && r.squaredNorm() > target; ++it) {
-        progress.poll(0.45 + 0.55 * double(it) / kMaxIterations);
+    const int iterations = whole_box ? kOuterIterations : kMaxIterations;
+    for (int it = 0; it < iterations && r.squaredNorm() > target; ++it) {
+        progress.poll(0.45 + 0.55 * double(it) / iterations);
         apply(p, Ap);
         const double step = rz / p.dot(Ap);
         x += step * p;
