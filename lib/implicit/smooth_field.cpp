@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 
 #include <Eigen/Sparse>
 
@@ -24,8 +25,15 @@ constexpr double kAgreeing = 0.3;
 // side, or after kMaxIterations.
 constexpr double kTolerance = 1e-4;
 constexpr int kMaxIterations = 300;
+// The outer field (over the whole box) stops after fewer: it starts from the band's
+// distances, it need only be settled near the band's edge, and far from the points only
+// its sign matters; most of the solve's time would otherwise go there.
+constexpr int kOuterIterations = 120;
 // Coarser levels of the cascade (each twice the previous step).
 constexpr int kCoarseLevels = 1;
+// The outer field's grid step, in fine steps: coarse enough to cover the whole box at a
+// small cost, fine enough to keep a thin wall's two sides apart where it hands over.
+constexpr double kOuterSteps = 2.0;
 // Memory model, for GMPU_PARAM_MAX_MEMORY: per node of a touched block, the splat's sums
 // (weight, distance, normal) and its index; per unknown, the field, the edges' matrix rows
 // and the solver's vectors; per point, its 8 trilinear weights and nodes.
@@ -48,6 +56,11 @@ int32_t SmoothField::node(int64_t x, int64_t y, int64_t z) const {
 SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, double spacing, double min_trust,
                          double noise, double max_memory, Progress &progress) {
     if (points.size() == 0) return;
+    // The outer field: the same problem on a coarser grid over the whole box, solved first.
+    auto outer = std::make_shared<SmoothField>();
+    outer->h_ = kOuterSteps * spacing;
+    Progress outer_progress = progress.slice(0.0, 0.1);
+    outer->solve(points, measures, min_trust, noise, max_memory, nullptr, nullptr, true, outer_progress);
     // The cascade: each coarser level (twice the step) solved first, its field the next
     // level's start.
     std::vector<double> steps{spacing};
@@ -57,18 +70,23 @@ SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, 
     for (size_t l = steps.size(); l-- > 1;) {
         SmoothField level;
         level.h_ = steps[l];
-        Progress slice = progress.slice((levels - 1 - double(l)) / levels * 0.2,
-                                        (levels - double(l)) / levels * 0.2);
-        level.solve(points, measures, min_trust, noise, max_memory, coarse.empty() ? nullptr : &coarse, slice);
+        Progress slice = progress.slice(0.1 + (levels - 1 - double(l)) / levels * 0.1,
+                                        0.1 + (levels - double(l)) / levels * 0.1);
+        level.solve(points, measures, min_trust, noise, max_memory, coarse.empty() ? nullptr : &coarse, outer.get(), false, slice);
         coarse = std::move(level);
     }
     h_ = spacing;
     Progress fine = progress.slice(steps.size() > 1 ? 0.2 : 0.0, 1.0);
-    solve(points, measures, min_trust, noise, max_memory, coarse.empty() ? nullptr : &coarse, fine);
+    const double shift = solve(points, measures, min_trust, noise, max_memory, coarse.empty() ? nullptr : &coarse, outer.get(), false, fine);
+    // The fine level's zero set is the surface: the outer field follows its shift, so the
+    // two agree where one hands over to the other.
+    for (double &v : outer->values_) v -= shift;
+    outer_ = std::move(outer);
 }
 
-void SmoothField::solve(const PointSet &points, const PointMeasures &measures, double min_trust, double noise,
-                        double max_memory, const SmoothField *coarse, Progress &progress) {
+double SmoothField::solve(const PointSet &points, const PointMeasures &measures, double min_trust, double noise,
+                          double max_memory, const SmoothField *coarse, const SmoothField *boundary, bool whole_box,
+                          Progress &progress) {
     const size_t n = points.size();
     auto radius = [&](size_t i) { return std::max(double(measures.trust_radius[i]), min_trust) + std::sqrt(3.0) * h_; };
     double widest = 0.0;
@@ -77,6 +95,7 @@ void SmoothField::solve(const PointSet &points, const PointMeasures &measures, d
     for (int d = 0; d < 3; ++d) {
         nodes_[d] = int64_t(std::ceil((points.box_max()[d] - origin_[d] + widest + 2.0 * h_) / h_)) + 1;
         blocks_[d] = (nodes_[d] + B - 1) / B;
+        if (whole_box) nodes_[d] = blocks_[d] * B;  // every slot node is then a grid node
     }
     const char *what = "the smooth surface's solve (GMPU_PARAM_SURFACE)";
     check_memory(double(blocks_[0]) * double(blocks_[1]) * double(blocks_[2]) * sizeof(int32_t), max_memory, what);
@@ -92,7 +111,9 @@ void SmoothField::solve(const PointSet &points, const PointMeasures &measures, d
         }
     };
     int32_t slots = 0;
-    for (size_t i = 0; i < n; ++i) {
+    if (whole_box)
+        for (int32_t &s : block_slot_) s = slots++;
+    for (size_t i = 0; i < n && !whole_box; ++i) {
         if (i % 1024 == 0) progress.poll(0.05 * double(i) / double(n));
         int64_t lo[3], hi[3];
         node_box(i, lo, hi);
@@ -140,7 +161,7 @@ void SmoothField::solve(const PointSet &points, const PointMeasures &measures, d
     node_index_.assign(slot_nodes, -1);
     int32_t unknowns = 0;
     for (size_t s = 0; s < slot_nodes; ++s)
-        if (wsum[s] > 0.0) node_index_[s] = unknowns++;
+        if (wsum[s] > 0.0 || whole_box) node_index_[s] = unknowns++;
 
     // Normal equations of the energy: every grid edge inside the band asks f to rise along it
     // by h times V's component (V = −average outward normal, f grows inward), every sample
@@ -161,13 +182,40 @@ void SmoothField::solve(const PointSet &points, const PointMeasures &measures, d
                 // point-to-plane distance.
                 double c;
                 const Eigen::Vector3d q = origin_ + h_ * Eigen::Vector3d(double(x), double(y), double(z));
-                start[u] = coarse && coarse->value(q, c, nullptr) ? c : distance[s] / wsum[s];
+                start[u] = coarse && coarse->value(q, c, nullptr) ? c : wsum[s] > 0.0 ? distance[s] / wsum[s] : 0.0;
                 // The average normal, shortened where neighbours disagree (between two sheets,
                 // across a thin part): there f need not rise at all.
-                field[size_t(u)] = -normal[s] / wsum[s];
+                field[size_t(u)] = wsum[s] > 0.0 ? Eigen::Vector3d(-normal[s] / wsum[s]) : Eigen::Vector3d::Zero();
                 const double length = field[size_t(u)].norm();
                 if (length > kAgreeing) field[size_t(u)] /= length;
             }
+    if (whole_box) {
+        // Away from the points the start copies the nearest band node's (breadth first):
+        // the exterior starts outside and enclosed regions on the side their band says,
+        // which is about where the smooth solution settles (it is flat there).
+        std::vector<uint8_t> reached(size_t(unknowns), 0);
+        std::vector<int64_t> queue;
+        for (int64_t z = 0; z < nodes_[2]; ++z)
+            for (int64_t y = 0; y < nodes_[1]; ++y)
+                for (int64_t x = 0; x < nodes_[0]; ++x)
+                    if (wsum[slot_of(x, y, z)] > 0.0) {
+                        reached[size_t(node(x, y, z))] = 1;
+                        queue.push_back(x + nodes_[0] * (y + nodes_[1] * z));
+                    }
+        for (size_t head = 0; head < queue.size(); ++head) {
+            const int64_t at = queue[head], x = at % nodes_[0], y = at / nodes_[0] % nodes_[1], z = at / nodes_[0] / nodes_[1];
+            const double v = start[node(x, y, z)];
+            for (int d = 0; d < 3; ++d)
+                for (int dir = -1; dir <= 1; dir += 2) {
+                    const int64_t bx = x + (d == 0) * dir, by = y + (d == 1) * dir, bz = z + (d == 2) * dir;
+                    const int32_t b = node(bx, by, bz);
+                    if (b < 0 || reached[size_t(b)]) continue;
+                    reached[size_t(b)] = 1;
+                    start[b] = v;
+                    queue.push_back(bx + nodes_[0] * (by + nodes_[1] * bz));
+                }
+        }
+    }
     std::vector<double>().swap(wsum);
     std::vector<double>().swap(distance);
     std::vector<Eigen::Vector3d>().swap(normal);
@@ -192,6 +240,30 @@ void SmoothField::solve(const PointSet &points, const PointMeasures &measures, d
                 }
             }
     }
+    // The band's edge: an edge to a node outside the band asks for the same rise towards the
+    // outer field's value there (a Dirichlet condition). Left free, f would keep rising
+    // along the normals to the band's edge: over a misoriented patch it rises outward and
+    // crosses zero where the band ends, a blister a band's width off the points. The outer
+    // field, solved over the whole box like screened Poisson's, lets the patch's error
+    // relax into the space around it instead.
+    if (boundary)
+        for (int64_t z = 0; z < nodes_[2]; ++z)
+            for (int64_t y = 0; y < nodes_[1]; ++y)
+                for (int64_t x = 0; x < nodes_[0]; ++x) {
+                    const int32_t a = node(x, y, z);
+                    if (a < 0) continue;
+                    for (int d = 0; d < 3; ++d)
+                        for (int dir = -1; dir <= 1; dir += 2) {
+                            const int64_t bx = x + (d == 0) * dir, by = y + (d == 1) * dir, bz = z + (d == 2) * dir;
+                            if (node(bx, by, bz) >= 0) continue;
+                            double fb;
+                            const Eigen::Vector3d qb = origin_ + h_ * Eigen::Vector3d(double(bx), double(by), double(bz));
+                            if (!boundary->value(qb, fb, nullptr)) continue;
+                            const double rise = h_ * field[size_t(a)][d] * double(dir);  // f_b − f_a wanted
+                            edge_diagonal[a] += edge_weight;
+                            rhs[a] += edge_weight * (fb - rise);
+                        }
+                }
     std::vector<Eigen::Vector3d>().swap(field);
     Eigen::SparseMatrix<double, Eigen::RowMajor> edges(unknowns, unknowns);
     edges.setFromTriplets(entries.begin(), entries.end());
@@ -251,8 +323,9 @@ void SmoothField::solve(const PointSet &points, const PointMeasures &measures, d
     Eigen::VectorXd z = inverse_diagonal.cwiseProduct(r), p = z;
     double rz = r.dot(z);
     const double target = kTolerance * kTolerance * std::max(rhs.squaredNorm(), 1e-300);
-    for (int it = 0; it < kMaxIterations && r.squaredNorm() > target; ++it) {
-        progress.poll(0.45 + 0.55 * double(it) / kMaxIterations);
+    const int iterations = whole_box ? kOuterIterations : kMaxIterations;
+    for (int it = 0; it < iterations && r.squaredNorm() > target; ++it) {
+        progress.poll(0.45 + 0.55 * double(it) / iterations);
         apply(p, Ap);
         const double step = rz / p.dot(Ap);
         x += step * p;
@@ -272,9 +345,11 @@ void SmoothField::solve(const PointSet &points, const PointMeasures &measures, d
         at_samples += at;
         count += 1.0;
     }
-    if (count > 0.0) x.array() -= at_samples / count;
+    const double shift = count > 0.0 ? at_samples / count : 0.0;
+    x.array() -= shift;
     values_.assign(x.data(), x.data() + unknowns);
     progress.report(1.0);
+    return shift;
 }
 
 Eigen::Vector3d SmoothField::node_gradient(int64_t x, int64_t y, int64_t z) const {
@@ -292,6 +367,11 @@ Eigen::Vector3d SmoothField::node_gradient(int64_t x, int64_t y, int64_t z) cons
 }
 
 bool SmoothField::value(const Eigen::Vector3d &x, double &f, Eigen::Vector3d *gradient) const {
+    if (band_value(x, f, gradient)) return true;
+    return outer_ && outer_->band_value(x, f, gradient);
+}
+
+bool SmoothField::band_value(const Eigen::Vector3d &x, double &f, Eigen::Vector3d *gradient) const {
     if (values_.empty()) return false;
     const Eigen::Vector3d t = (x - origin_) / h_;
     if (!(t.array() >= 0.0).all() || !(t.array() < 1e9).all()) return false;

@@ -17,14 +17,19 @@
 // are central differences at the nodes, interpolated the same way.
 //
 // The band reaches every point's trust radius (widened to `min_trust`) plus a cell
-// diagonal, so wherever the surface field trusts the data a smooth value exists; outside
-// it the surface field's far sign still decides (each connected part of the band holds
-// points, so the problem is well posed). The solve is cascadic: the same problem on a grid
-// twice as coarse gives the fine solve its start, so conjugate gradients only have the
-// fine detail left to converge (they converge slowly on the smooth, long-range part).
+// diagonal, so wherever the surface field trusts the data a smooth value exists. Around it,
+// an outer field solves the same problem on a coarser grid over the whole box (no normals
+// away from the points: f settles flat there, as in screened Poisson), and the band's edge
+// takes its values (Dirichlet): a misoriented patch's error then relaxes into the space
+// around it instead of rising to the band's edge, and the surface field uses the outer
+// field instead of its far sign wherever the band ends. The solve is cascadic: the same
+// problem on a grid twice as coarse gives the fine solve its start, so conjugate gradients
+// only have the fine detail left to converge (they converge slowly on the smooth,
+// long-range part).
 #pragma once
 
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include <Eigen/Core>
@@ -47,7 +52,8 @@ public:
     SmoothField(const PointSet &points, const PointMeasures &measures, double spacing, double min_trust, double noise,
                 double max_memory, Progress &progress);
 
-    // f and optionally ∇f at x; false when x lies outside the band (f is then undefined).
+    // f and optionally ∇f at x: the band's where it is defined, else the outer field's;
+    // false outside the outer field's box (f is then undefined).
     bool value(const Eigen::Vector3d &x, double &f, Eigen::Vector3d *gradient) const;
 
     bool empty() const { return values_.empty(); }
@@ -56,8 +62,13 @@ public:
 
 private:
     static constexpr int B = 8;  // nodes per block side of the sparse storage
-    void solve(const PointSet &points, const PointMeasures &measures, double min_trust, double noise,
-               double max_memory, const SmoothField *coarse, Progress &progress);
+    // Returns the shift that made f's mean over the samples 0. `boundary` (may be null) gives
+    // the band's edge its values; `whole_box` solves on every node of the box, not a band.
+    double solve(const PointSet &points, const PointMeasures &measures, double min_trust, double noise,
+                 double max_memory, const SmoothField *coarse, const SmoothField *boundary, bool whole_box,
+                 Progress &progress);
+    // The band's own value (the fine grid only).
+    bool band_value(const Eigen::Vector3d &x, double &f, Eigen::Vector3d *gradient) const;
     int32_t node(int64_t x, int64_t y, int64_t z) const;  // unknown index, -1 outside the band
     Eigen::Vector3d node_gradient(int64_t x, int64_t y, int64_t z) const;
 
@@ -68,6 +79,7 @@ private:
     std::vector<int32_t> block_slot_;  // per block: its slot in node_index_ (÷ B³), or -1
     std::vector<int32_t> node_index_;  // per slot node: unknown index or -1
     std::vector<double> values_;       // per unknown
+    std::shared_ptr<const SmoothField> outer_;  // the coarse field over the whole box, or null
 };
 
 }  // namespace gmpu

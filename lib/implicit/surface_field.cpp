@@ -70,8 +70,13 @@ double SurfaceField::far_value(const Eigen::Vector3d &x, Eigen::Vector3d *gradie
 }
 
 double SurfaceField::value(const Eigen::Vector3d &x, Eigen::Vector3d *gradient) const {
-    if (!trusted(x)) return far_value(x, gradient);
     double v;
+    if (!trusted(x)) {
+        // The smooth field covers the box (its outer part): it, not the far field, meets
+        // its own band's edge.
+        if (smooth_ && smooth_->value(x, v, gradient)) return v;
+        return far_value(x, gradient);
+    }
     if (smooth_ && smooth_->value(x, v, gradient)) return v;
     return mpu_.value(x, gradient);
 }
@@ -133,6 +138,8 @@ void SurfaceField::block_values(const LatticeBlock &block, const uint32_t *near,
                 double v;
                 if (trusted[at]) {
                     v = trusted_value(block.leaves_at(i, j, k), block.corner(i, j, k), nullptr);
+                } else if (smooth_ && smooth_->value(block.corner(i, j, k), v, nullptr)) {
+                    // Untrusted, but inside the smooth field's box: its value, as in value().
                 } else {
                     // Trilinear in the coarse cell holding the corner.
                     const int ci = std::min(i / S, CC - 2) * S, cj = std::min(j / S, CC - 2) * S,

@@ -11,7 +11,9 @@
 // nearest ones can all face away from x beyond a concave part): continuous
 // enough at the border (the blend is about a signed distance too) and never zero, so no
 // surface can appear away from the data. With a smooth field (smooth_field.hpp), trusted
-// queries take its value instead of the blend's wherever it is defined.
+// queries take its value instead of the blend's wherever it is defined, and untrusted ones
+// inside its box take its outer field instead of the far field (the two meet at the band's
+// edge with the same values, where the far sign could disagree).
 #pragma once
 
 #include <algorithm>
