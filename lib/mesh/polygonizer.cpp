@@ -13,6 +13,7 @@
 #include "mesh/mesh_cleanup.hpp"
 #include "mesh/point_buckets.hpp"
 #include "mesh/sharpen.hpp"
+#include "mesh/size_cap.hpp"
 #include "mesh/weld.hpp"
 
 namespace gmpu {
@@ -51,6 +52,9 @@ constexpr double kRootTolerance = 1e-4;
 // the 5k-point thin plate lost 0.01 of F@1 % with them).
 constexpr double kCleanNoise = 0.05;
 constexpr double kDenseSpacing = 1.0;
+// Decimation of a default mesh over its triangle budget (size_cap.hpp) may move the surface
+// by at most this share of the fit's tolerance ε: the fit itself is only trusted to ε.
+constexpr double kCapErrorShare = 0.5;
 
 // Mean sample spacing: the square root of the area each point stands for.
 double mean_spacing(const PointMeasures &measures) {
@@ -250,7 +254,7 @@ Mesh polygonize(const SurfaceField &field, int resolution, const Params &params,
     // the weld, the cleanup.
     Progress grid_progress = progress.slice(0.0, 0.02), blocks_progress = progress.slice(0.02, 0.95),
              weld_progress = progress.slice(0.95, 0.97), cleanup_progress = progress.slice(0.97, 0.98),
-             sharpen_progress = progress.slice(0.98, 1.0);
+             sharpen_progress = progress.slice(0.98, 0.99), cap_progress = progress.slice(0.99, 1.0);
     const double h = 1.0 / resolution, min_trust = 2.0 * h;
     const bool clean = noise < kCleanNoise * h && mean_spacing(measures) < kDenseSpacing * h;
     // Before allocating anything: the grid alone, then with the band, must fit the budget.
@@ -293,6 +297,8 @@ Mesh polygonize(const SurfaceField &field, int resolution, const Params &params,
     progress.throw_if_cancelled();
     remove_unsupported_components(mesh, votes, kMinVotes, cleanup_progress);
     if (clean) sharpen_features(mesh, kSharpenReach * h / points.normalisation().scale, sharpen_progress);
+    // A grid the caller chose keeps all its triangles.
+    if (params.resolution == 0) cap_mesh_size(mesh, points.size(), kCapErrorShare * params.error, cap_progress);
     return mesh;  // the caller makes the final report, once the temporaries are freed
 }
 

@@ -19,6 +19,10 @@ namespace {
 // A round that breaks the topology is redone with more vertices locked, this many times in
 // a row at most, before simplification stops where it is.
 constexpr int kRetries = 12;
+// Rings of neighbours locked around a vertex where a round broke the topology: one ring
+// leaves the collapses next to it free to break it again a vertex further on, and every
+// redone round costs a whole pass over the mesh.
+constexpr int kLockRings = 2;
 
 // Vertices at identical positions become one, so that collapses see the true neighbourhood
 // (a duplicate would look like a border and be locked or torn). Degenerate triangles go.
@@ -31,9 +35,13 @@ Mesh welded(const Mesh &in) {
     out.vertices.resize(3 * unique);
     if (!in.confidence.empty()) out.confidence.resize(unique);
     if (!in.colors.empty()) out.colors.resize(3 * unique);
+    const bool normals = in.normals.size() == in.vertices.size();
+    if (normals) out.normals.resize(3 * unique);
     for (size_t v = 0; v < n; ++v) {
         if (remap[v] == ~0u) continue;
         for (int d = 0; d < 3; ++d) out.vertices[3 * remap[v] + d] = in.vertices[3 * v + d];
+        if (normals)
+            for (int d = 0; d < 3; ++d) out.normals[3 * remap[v] + d] = in.normals[3 * v + d];
         if (!in.confidence.empty()) out.confidence[remap[v]] = in.confidence[v];
         if (!in.colors.empty())
             for (int d = 0; d < 3; ++d) out.colors[3 * remap[v] + d] = in.colors[3 * v + d];
@@ -56,6 +64,8 @@ Mesh compacted(const Mesh &base, const std::vector<uint32_t> &triangles) {
         if (index[v] == UINT32_MAX) {
             index[v] = uint32_t(out.vertices.size() / 3);
             out.vertices.insert(out.vertices.end(), base.vertices.begin() + 3 * v, base.vertices.begin() + 3 * v + 3);
+            if (base.normals.size() == base.vertices.size())
+                out.normals.insert(out.normals.end(), base.normals.begin() + 3 * v, base.normals.begin() + 3 * v + 3);
             if (!base.confidence.empty()) out.confidence.push_back(base.confidence[v]);
             if (!base.colors.empty())
                 out.colors.insert(out.colors.end(), base.colors.begin() + 3 * v, base.colors.begin() + 3 * v + 3);
@@ -132,7 +142,8 @@ size_t collapse_round(const std::vector<uint32_t> &triangles, const std::vector<
 
 }  // namespace
 
-Mesh simplify_mesh(const Mesh &mesh, size_t target_triangles, double target_error, double *achieved_error) {
+Mesh simplify_mesh(const Mesh &mesh, size_t target_triangles, double target_error, double *achieved_error,
+                   bool keep_normals) {
     if (achieved_error) *achieved_error = 0.0;
     if (mesh.triangles.empty()) return Mesh();  // nothing to weld or collapse (and no vertex in use)
     Mesh base = welded(mesh);
@@ -180,13 +191,18 @@ Mesh simplify_mesh(const Mesh &mesh, size_t target_triangles, double target_erro
         }
         std::vector<char> bad(n, 0);
         for (uint32_t v : culprits) bad[v] = 1;
-        for (const std::vector<uint32_t> *tris : {&current, &next})
-            for (size_t t = 0; t < tris->size(); t += 3)
-                if (bad[(*tris)[t]] || bad[(*tris)[t + 1]] || bad[(*tris)[t + 2]])
-                    for (int k = 0; k < 3; ++k) locked[(*tris)[t + k]] = 1;
+        for (int ring = 0; ring < kLockRings; ++ring) {
+            std::vector<char> grown = bad;
+            for (const std::vector<uint32_t> *tris : {&current, &next})
+                for (size_t t = 0; t < tris->size(); t += 3)
+                    if (bad[(*tris)[t]] || bad[(*tris)[t + 1]] || bad[(*tris)[t + 2]])
+                        for (int k = 0; k < 3; ++k) grown[(*tris)[t + k]] = 1;
+            bad.swap(grown);
+        }
+        for (size_t v = 0; v < n; ++v) locked[v] = locked[v] || bad[v];
     }
     Mesh out = compacted(base, current);
-    recompute_normals(out);
+    if (!keep_normals || out.normals.size() != out.vertices.size()) recompute_normals(out);
     if (achieved_error) *achieved_error = spent;
     return out;
 }

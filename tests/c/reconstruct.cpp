@@ -38,6 +38,8 @@ Reconstruction reconstruct(const std::vector<Vec3> &points, const std::vector<st
     if (fail(gmpu_surface_polygonize(r.surface, &mesh))) return r;
     r.mesh = mesh_from_arrays(gmpu_mesh_vertices(mesh), gmpu_mesh_vertex_count(mesh), gmpu_mesh_triangles(mesh),
                               gmpu_mesh_triangle_count(mesh));
+    const double *n = gmpu_mesh_normals(mesh);
+    for (size_t i = 0; n && i < gmpu_mesh_vertex_count(mesh); ++i) r.mesh_normals.emplace_back(n[3 * i], n[3 * i + 1], n[3 * i + 2]);
     gmpu_mesh_destroy(mesh);
     return r;
 }

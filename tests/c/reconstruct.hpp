@@ -15,6 +15,7 @@ struct Reconstruction {
     gmpu_status status = GMPU_OK;
     std::string error;             // gmpu_last_error() of the failing call
     TriangleMesh mesh;
+    std::vector<Vec3> mesh_normals;  // per mesh vertex
     std::vector<Vec3> normals;     // oriented normal per input point
     gmpu_surface *surface = nullptr;  // kept alive for evaluate(); freed by the destructor
 
@@ -26,6 +27,7 @@ struct Reconstruction {
         std::swap(status, o.status);
         std::swap(error, o.error);
         std::swap(mesh, o.mesh);
+        std::swap(mesh_normals, o.mesh_normals);
         std::swap(normals, o.normals);
         std::swap(surface, o.surface);
         return *this;

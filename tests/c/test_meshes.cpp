@@ -3,6 +3,8 @@
 // trimming by it opens the caps polygonize puts over a scan's holes; the level-of-detail
 // cap keeps the components and genus of the full surface.
 #include <algorithm>
+#include <array>
+#include <map>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -318,6 +320,46 @@ void mesh_size_follows_the_points(void **) {
     assert_true(resolution[1] > 1.3 * resolution[0]);
 }
 
+// A thin hollow sphere: the grid is refined to the wall's gap, far finer than the points
+// ask, so marching cubes makes several triangles per point. The default mesh is decimated
+// to at most 2 per point, still closed, edge-manifold and outward, with both shells, each
+// a sphere, within a fraction of the fit's tolerance of the full mesh, its vertices and
+// normals the full mesh's; a grid the caller sets keeps every triangle.
+void thin_wall_mesh_has_at_most_two_triangles_per_point(void **) {
+    const NestedSpheres shell(Vec3(0, 0, 0), 0.9, 1.0);
+    const std::vector<Vec3> points = shell.sample(4000, 5).positions;
+    const Reconstruction r = reconstruct(points);
+    assert_int_equal(r.status, GMPU_OK);
+    const MeshCheck c = check_mesh(r.mesh);
+    fprintf(stderr, "  resolution %.0f: %zu triangles for %zu points\n", r.stat(GMPU_STAT_RESOLUTION),
+            r.mesh.triangles.size(), points.size());
+    assert_true(c.watertight);
+    assert_int_equal(c.nonmanifold_vertices, 0);
+    assert_int_equal(c.components, 2);
+    assert_true(genera(c) == std::vector<int>({0, 0}));
+    assert_true(c.signed_volume > 0);
+    assert_true(r.mesh.triangles.size() <= 2 * points.size());
+    const Reconstruction full = reconstruct(points, {{GMPU_PARAM_RESOLUTION, r.stat(GMPU_STAT_RESOLUTION)}});
+    assert_int_equal(full.status, GMPU_OK);
+    // ε is 0.002 of the diagonal (2√3 here); the decimation may move the surface by half of
+    // it (meshoptimizer's error is an estimate: allow twice that).
+    const double moved = one_sided_distance(full.mesh, r.mesh);
+    fprintf(stderr, "  at the same resolution set by the caller: %zu triangles, %.5f away at most\n",
+            full.mesh.triangles.size(), moved);
+    assert_true(moved < 0.002 * 2 * std::sqrt(3.0));
+    assert_true(full.mesh.triangles.size() > r.mesh.triangles.size());
+    // The kept vertices are the full mesh's, with its normals (−∇f), not the faces'.
+    std::map<std::array<double, 3>, Vec3> normal_at;
+    for (size_t v = 0; v < full.mesh.vertices.size(); ++v)
+        normal_at[{full.mesh.vertices[v][0], full.mesh.vertices[v][1], full.mesh.vertices[v][2]}] = full.mesh_normals[v];
+    assert_int_equal(r.mesh_normals.size(), r.mesh.vertices.size());
+    for (size_t v = 0; v < r.mesh.vertices.size(); ++v) {
+        const auto found = normal_at.find({r.mesh.vertices[v][0], r.mesh.vertices[v][1], r.mesh.vertices[v][2]});
+        assert_true(found != normal_at.end());
+        assert_true(found->second == r.mesh_normals[v]);
+    }
+}
+
 // Every vertex lies on the implicit (a root of f along its grid edge), not on the linear
 // interpolant between the edge's corners, which is off by a share of a cube on the torus.
 void vertices_lie_on_the_implicit(void **) {
@@ -429,6 +471,7 @@ int main(void) {
         cmocka_unit_test(confidence_in_ply),
         cmocka_unit_test(level_of_detail_keeps_the_topology_of_the_full_surface),
         cmocka_unit_test(mesh_size_follows_the_points),
+        cmocka_unit_test(thin_wall_mesh_has_at_most_two_triangles_per_point),
         cmocka_unit_test(vertices_lie_on_the_implicit),
         cmocka_unit_test(sharp_edges_stay_sharp),
         cmocka_unit_test(noisy_vertices_stay_interpolated),
