@@ -342,9 +342,11 @@ def _pieces(xyz: np.ndarray, grid: Grid, which: np.ndarray) -> Tuple[np.ndarray,
     from scipy.sparse.csgraph import connected_components
     n = grid.cells + 3  # cube keys with room for the ±1 neighbours
     key = np.zeros(len(xyz), np.int64)
-    for d in (2, 1, 0):  # one axis at a time: no n×3 integer copy of the points
-        key *= n[d]
-        key += np.floor((xyz[:, d] - grid.origin[d]) / grid.cell).astype(np.int64) + 1
+    for start in range(0, len(xyz), _CHUNK):  # a chunk and an axis at a time: no integer copy of the points
+        k = key[start:start + _CHUNK]
+        for d in (2, 1, 0):
+            k *= n[d]
+            k += np.floor((xyz[start:start + _CHUNK, d] - grid.origin[d]) / grid.cell).astype(np.int64) + 1
     cubes = np.unique(key)
     which_cube = np.searchsorted(cubes, key[which])
     del key
@@ -435,6 +437,7 @@ def _tile_surface(source: Any, plan: TilePlan, tile: int, params: Dict[str, Any]
     del idx, inner
     centres, cube_piece, out["shared_pieces"] = _pieces(xyz, g, shared)
     pieces = int(cube_piece.max()) + 1
+    shared_xyz = xyz[shared]
     lap("pieces")
     with Surface(xyz, **params) as s:
         del xyz  # the surface holds its own copy: only it while fitting
@@ -445,7 +448,11 @@ def _tile_surface(source: Any, plan: TilePlan, tile: int, params: Dict[str, Any]
         blocks = g.block_of_key(keys)
         values = _evaluate_grid(s, g, blocks)
         lap("evaluate")
-        normals = s.normals[shared]
+        # The overlap points' normals from the field's gradient there (−∇f points outward):
+        # the tile's every point normal would be a copy of all its points at the surface's peak.
+        _, gradients = s.evaluate(shared_xyz, gradient=True)
+        length = np.linalg.norm(gradients, axis=1, keepdims=True)
+        normals = -gradients / np.where(length > 0, length, 1)
     if reverse:
         values, normals = -values, -normals
     labels = _corner_pieces(centres, cube_piece, g, blocks) if pieces > 1 else np.zeros(values.shape, np.int32)
