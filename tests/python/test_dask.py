@@ -267,15 +267,3 @@ def test_sorting_pass_memory_does_not_grow_with_the_margin(cloud):
         assert len(written) == len(plan.tiles)
     assert peak < 200 * len(cloud), peak  # bytes a point
 
-
-def test_a_tile_takes_only_its_overlap_normals(cloud, monkeypatch):
-    """The overlap sample's normals come from the field's gradient at those points: a copy of
-    every point's normal would sit beside the surface at its peak."""
-    def every_normal(self):
-        raise AssertionError("a tile copied every point's normal")
-    monkeypatch.setattr(gmpu.Surface, "normals", property(every_normal))
-    plan = gd.plan_tiles(cloud, len(cloud), cloud.min(0), np.nextafter(cloud.max(0), np.inf),
-                         tile_points=TILE_POINTS, resolution=64)
-    out = gd._tile_surface(cloud, plan, 0, {"threads": 1})
-    assert len(out["normals"]) == len(out["shared"]) > 0
-    assert np.allclose(np.linalg.norm(out["normals"], axis=1), 1, atol=1e-3)

@@ -437,7 +437,6 @@ def _tile_surface(source: Any, plan: TilePlan, tile: int, params: Dict[str, Any]
     del idx, inner
     centres, cube_piece, out["shared_pieces"] = _pieces(xyz, g, shared)
     pieces = int(cube_piece.max()) + 1
-    shared_xyz = xyz[shared]
     lap("pieces")
     with Surface(xyz, **params) as s:
         del xyz  # the surface holds its own copy: only it while fitting
@@ -448,11 +447,7 @@ def _tile_surface(source: Any, plan: TilePlan, tile: int, params: Dict[str, Any]
         blocks = g.block_of_key(keys)
         values = _evaluate_grid(s, g, blocks)
         lap("evaluate")
-        # The overlap points' normals from the field's gradient there (−∇f points outward):
-        # the tile's every point normal would be a copy of all its points at the surface's peak.
-        _, gradients = s.evaluate(shared_xyz, gradient=True)
-        length = np.linalg.norm(gradients, axis=1, keepdims=True)
-        normals = -gradients / np.where(length > 0, length, 1)
+        normals = s.normals[shared]
     if reverse:
         values, normals = -values, -normals
     labels = _corner_pieces(centres, cube_piece, g, blocks) if pieces > 1 else np.zeros(values.shape, np.int32)
