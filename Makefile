@@ -222,7 +222,7 @@ DASK_POINTS ?= 10000000
 DASK_SCALE_POINTS ?= 100000000
 .PHONY: bench-dask
 bench-dask: deps-bench build
-	$(PYTHON) tests/bench/dask_bench.py --build $(BUILD) --out bench-results/dask --points $(DASK_POINTS) --kill-check 1000000 \
+	$(PYTHON) tests/bench/dask_bench.py --build $(BUILD) --out bench-results/dask --points $(DASK_POINTS) --kill-check \
 		--scale-points $(DASK_SCALE_POINTS)
 
 # The corpus section alone (issue 13's targets on 106 generated clouds).

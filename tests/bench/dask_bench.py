@@ -8,7 +8,9 @@ seed 17, float32 binary PLY so that the tiles memory-map it):
   the untiled run's grid resolution: wall, peak RSS of each worker and of the driver;
 - seams: boundary and non-manifold edges of the tiled mesh; Chamfer (mean nearest-vertex
   distance, both ways) to the untiled mesh as a share of the diagonal; orientation: the
-  share of tiled vertices whose normal agrees with the nearest untiled vertex's.
+  share of tiled vertices whose normal agrees with the nearest untiled vertex's;
+- with --kill-check, the tiled run again with one worker killed part way: the mesh must be
+  identical.
 
     /usr/bin/python3 tests/bench/dask_bench.py --build build --out bench-results/dask [--points 10000000]
 
@@ -156,8 +158,15 @@ def local_client(workers):
         cluster.close()
 
 
-def tiled_run(cloud, resolution, tile_points, workers):
+def tiled_run(cloud, resolution, tile_points, workers, kill=False):
+    """The tiled run on a fresh LocalCluster: wall, peak RSS per worker and of the driver.
+    With `kill`, the fault-tolerance check on the same cloud: the run again with one worker
+    process killed (SIGKILL) half-way through the first run's first phase; the nanny restarts
+    it, Dask recomputes what it held, and the mesh must be identical to the first run's."""
+    import signal
+    import threading
     import gmpu.dask as gd
+    killed = None
     with local_client(workers) as client:
         stats = {}
         t = time.perf_counter()
@@ -165,32 +174,20 @@ def tiled_run(cloud, resolution, tile_points, workers):
                               threads=1)
         wall = time.perf_counter() - t
         peaks = client.run(lambda: resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024)
+        if kill:
+            pid = sorted(client.run(os.getpid).values())[0]
+            killer = threading.Timer(0.5 * stats["phase1_seconds"], lambda: os.kill(pid, signal.SIGKILL))
+            killer.start()
+            disturbed = gd.reconstruct(str(cloud), client, tile_points=tile_points, resolution=resolution,
+                                       threads=1)
+            killer.join()
+            restarted = pid not in client.run(os.getpid).values()
+            same = (np.array_equal(np.asarray(mesh.vertices), np.asarray(disturbed.vertices)) and
+                    np.array_equal(np.asarray(mesh.faces), np.asarray(disturbed.faces)))
+            killed = (same, restarted)
+            del disturbed
     driver = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
-    return mesh, wall, sorted(peaks.values()), driver, stats
-
-
-def kill_check(cloud, resolution, tile_points, workers):
-    """Fault tolerance: the tiled run again, with one worker process killed (SIGKILL) part way
-    through its first phase; the nanny restarts it, Dask recomputes what it held, and the mesh
-    must be identical to an undisturbed run's."""
-    import signal
-    import threading
-    import gmpu.dask as gd
-    with local_client(workers) as client:
-        stats = {}
-        t = time.perf_counter()
-        clean = gd.reconstruct(str(cloud), client, tile_points=tile_points, resolution=resolution, stats=stats,
-                               threads=1)
-        first_phase = stats["phase1_seconds"]
-        pid = sorted(client.run(os.getpid).values())[0]
-        killer = threading.Timer(0.5 * first_phase, lambda: os.kill(pid, signal.SIGKILL))
-        killer.start()
-        disturbed = gd.reconstruct(str(cloud), client, tile_points=tile_points, resolution=resolution, threads=1)
-        killer.join()
-        restarted = pid not in client.run(os.getpid).values()
-    same = (np.array_equal(np.asarray(clean.vertices), np.asarray(disturbed.vertices)) and
-            np.array_equal(np.asarray(clean.faces), np.asarray(disturbed.faces)))
-    return same, restarted, time.perf_counter() - t
+    return mesh, wall, sorted(peaks.values()), driver, stats, killed
 
 
 def mesh_topology(faces, vertex_count):
@@ -246,8 +243,8 @@ def main():
     ap.add_argument("--points", type=int, default=10_000_000)
     ap.add_argument("--tile-points", type=int, default=1_000_000)
     ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--kill-check", type=int, default=0,
-                    help="points of a cloud on which a worker is killed mid-run (0: no check)")
+    ap.add_argument("--kill-check", action="store_true",
+                    help="run the tiled point twice, killing a worker in the second run: the meshes must be identical")
     ap.add_argument("--scale-points", type=int, default=0,
                     help="points of the scale point (a mosaic of bunnies, tiled only; 0: none)")
     ap.add_argument("--scale-side", type=int, default=10, help="the mosaic is side × side bunnies")
@@ -270,7 +267,9 @@ def main():
     untiled_mesh = out / "untiled.ply"
     u_wall, u_peak, resolution = untiled_run(args.build, cloud, untiled_mesh)
     print(f"untiled: {u_wall:.1f} s wall, {u_peak / 1e9:.2f} GB peak, resolution {resolution}", flush=True)
-    mesh, t_wall, peaks, driver, stats = tiled_run(cloud, resolution, args.tile_points, args.workers)
+    load = os.getloadavg()
+    mesh, t_wall, peaks, driver, stats, killed = tiled_run(cloud, resolution, args.tile_points, args.workers,
+                                                           args.kill_check)
     boundary, nonmanifold = edge_problems(np.asarray(mesh.faces))
     components, genus = mesh_topology(np.asarray(mesh.faces), len(mesh.vertices))
     uv, uf, un = read_mesh_ply(untiled_mesh)
@@ -284,19 +283,19 @@ def main():
         "genus": genus, "chamfer_share_of_diagonal": cham / diagonal, "orientation_agreement": agree,
         "tiled_volume_positive": bool(mesh.volume > 0), "resolution": resolution,
         "phase1_seconds": round(stats["phase1_seconds"], 2), "tile_seconds": stats["tile_seconds"],
+        "tile_points_with_margin": stats["tile_points"], "tile_resident_bytes": stats["tile_resident_bytes"],
+        "load_average": [round(x, 1) for x in load],
     }
     print(f"tiled:   {t_wall:.1f} s wall, workers {[round(p / 1e9, 2) for p in peaks]} GB peak, driver "
           f"{driver / 1e9:.2f} GB; {stats['tiles']} tiles; boundary {boundary}, non-manifold {nonmanifold}, "
           f"components {components}, genus {genus}; Chamfer {100 * cham / diagonal:.4f} % of the diagonal; "
-          f"orientation agreement {100 * agree:.3f} %", flush=True)
-    if args.kill_check:
-        small = out / f"bunny_{args.kill_check}.ply"
-        if not small.exists():
-            write_cloud(small, args.kill_check)
-        same, restarted, seconds = kill_check(small, resolution, max(args.kill_check // 4, 1), args.workers)
-        row.update(kill_check_points=args.kill_check, kill_check_identical=same, kill_check_worker_restarted=restarted)
-        print(f"killed a worker mid-run on {args.kill_check} points: worker restarted {restarted}, mesh identical "
-              f"{same} ({seconds:.0f} s for both runs)", flush=True)
+          f"orientation agreement {100 * agree:.3f} %; load average {load[0]:.1f}", flush=True)
+    print(f"tiles:   points with margin {min(stats['tile_points'])}..{max(stats['tile_points'])}; resident MB after "
+          + ", ".join(f"{k} {v / 1e6:.0f}" for k, v in stats["tile_resident_bytes"].items()), flush=True)
+    if killed is not None:
+        row.update(kill_check_identical=killed[0], kill_check_worker_restarted=killed[1])
+        print(f"killed a worker mid-run on {args.points} points: worker restarted {killed[1]}, mesh identical "
+              f"{killed[0]}", flush=True)
     if args.scale_points:
         row.update(scale_run(out, args.scale_points, args.scale_side,
                              args.scale_resolution or 107 * 2 * args.scale_side, args.tile_points, args.workers))

@@ -107,6 +107,8 @@ def tiled(cloud, untiled, client):
 def test_the_cloud_spans_eight_tiles(tiled):
     assert tiled[1]["tiles"] == 8
     assert all(n > 0 for n in tiled[1]["tile_points"])
+    # Where a tile's memory goes: resident size after each stage, and the peak.
+    assert tiled[1]["tile_peak_bytes"] > 0 and min(tiled[1]["tile_resident_bytes"].values()) > 0
 
 
 def test_the_union_is_closed_and_manifold(tiled):
@@ -241,3 +243,27 @@ def test_streamed_mesh_is_welded_and_appears_whole(tmp_path):
             sink.abort()
             raise
     assert sorted(p.name for p in tmp_path.iterdir()) == ["m.ply"]  # no half-written file, no parts
+
+
+def test_sorting_pass_memory_does_not_grow_with_the_margin(cloud):
+    """The sorting pass writes each point to every tile whose box plus margin holds it, and
+    holds a few copies of its chunk whatever the margin (16 cubes: two blocks each way)."""
+    import tempfile
+    import tracemalloc
+    plan = gd.plan_tiles(cloud, len(cloud), cloud.min(0), np.nextafter(cloud.max(0), np.inf),
+                         tile_points=TILE_POINTS, resolution=128, margin_cells=16)
+    source = gd._Source(array=cloud)
+    with tempfile.TemporaryDirectory() as directory:
+        tracemalloc.start()
+        written = gd._sort_chunk(source, plan, 0, directory)
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
+        size = gd.BLOCK * plan.grid.cell
+        for t, path in written:
+            bl, bh = plan.tiles[t]
+            lo, hi = plan.grid.origin + bl * size - plan.margin, plan.grid.origin + bh * size + plan.margin
+            expected = np.flatnonzero(np.all((cloud >= lo) & (cloud < hi), axis=1))
+            assert np.array_equal(np.load(path)["index"], expected)
+        assert len(written) == len(plan.tiles)
+    assert peak < 200 * len(cloud), peak  # bytes a point
+

@@ -159,72 +159,57 @@ class _TileFiles:
         self.paths, self.count = list(paths), count
 
     def select(self, lo: np.ndarray, hi: np.ndarray) -> Tuple[np.ndarray, np.ndarray]:
-        parts = [np.load(p) for p in self.paths]
-        if not parts:
-            return np.zeros(0, np.int64), np.zeros((0, 3))
-        rows = np.concatenate(parts)
-        xyz = np.stack([rows["x"], rows["y"], rows["z"]], axis=1).astype(np.float64)
+        """Indices and float64 positions of the tile's points in [lo, hi), filled one file at
+        a time into arrays of the final size (no concatenated copy of the whole)."""
+        sizes = [np.load(p, mmap_mode="r").shape[0] for p in self.paths]
+        idx, xyz = np.empty(sum(sizes), np.int64), np.empty((sum(sizes), 3))
+        at = 0
+        for path, size in zip(self.paths, sizes):
+            rows = np.load(path)
+            idx[at:at + size] = rows["index"]
+            for d, name in enumerate("xyz"):
+                xyz[at:at + size, d] = rows[name]
+            at += size
+            del rows
         keep = np.all((xyz >= lo) & (xyz < hi), axis=1)
-        return rows["index"][keep], xyz[keep]
+        if not keep.all():
+            idx, xyz = idx[keep], xyz[keep]
+        return idx, xyz
 
 
 def _sort_chunk(source: "_Source", plan: "TilePlan", start: int, directory: str) -> List[Tuple[int, str]]:
     """One pass of the points [start, start + chunk): each point written to the file of every
     tile whose box plus margin holds it (tile t, chunk c: t<t>_<c>.npy). Returns (tile,
     file) per file written. Each tile then reads only its own points, instead of every tile
-    scanning the whole cloud."""
+    scanning the whole cloud. One box test per tile: memory stays a few copies of the chunk
+    whatever the margin (candidate pairs per neighbouring block would grow with its cube)."""
     g, m = plan.grid, plan.margin
     if source.layout:
         rows = source._mapped()[start:start + _CHUNK]
         xyz = np.stack([rows["x"], rows["y"], rows["z"]], axis=1)
+        del rows
     else:
         xyz = source.array[start:start + _CHUNK]
     p = xyz.astype(np.float64)
     size = BLOCK * g.cell
-    block = np.floor((p - g.origin) / size).astype(np.int64)
-    owner = _tile_of_block(plan)
     lo = np.array([bl for bl, _ in plan.tiles]) * size + g.origin - m
     hi = np.array([bh for _, bh in plan.tiles]) * size + g.origin + m
-    reach = int(np.ceil(m / size))
-    pairs = []
-    for dz in range(-reach, reach + 1):
-        for dy in range(-reach, reach + 1):
-            for dx in range(-reach, reach + 1):
-                b = block + np.array([dx, dy, dz])
-                ok = np.all((b >= 0) & (b < g.blocks), axis=1)
-                t = np.where(ok, owner[g.block_key(np.where(ok[:, None], b, 0))], -1)
-                inside = (t >= 0) & np.all((p >= lo[t]) & (p < hi[t]), axis=1)
-                pairs.append(np.flatnonzero(inside) * len(plan.tiles) + t[inside])
-    code = np.unique(np.concatenate(pairs))
-    point, tile = code // len(plan.tiles), code % len(plan.tiles)
     dtype = np.dtype([("index", "<i8"), ("x", xyz.dtype), ("y", xyz.dtype), ("z", xyz.dtype)])
     written = []
-    order = np.argsort(tile, kind="stable")
-    tile, point = tile[order], point[order]
-    bounds = np.flatnonzero(np.diff(tile)) + 1
-    for a, b in zip(np.r_[0, bounds], np.r_[bounds, len(tile)]):
-        if a == b:
+    for t in range(len(plan.tiles)):
+        point = np.flatnonzero(np.all((p >= lo[t]) & (p < hi[t]), axis=1))
+        if len(point) == 0:
             continue
-        t = int(tile[a])
-        out = np.empty(b - a, dtype)
-        out["index"] = start + point[a:b]
+        out = np.empty(len(point), dtype)
+        out["index"] = start + point
         for d, name in enumerate("xyz"):
-            out[name] = xyz[point[a:b], d]
+            out[name] = xyz[point, d]
         path = os.path.join(directory, f"t{t}_{start}.npy")
         with open(path + ".part", "wb") as f:  # renamed whole: a rerun after a lost worker rewrites it
             np.save(f, out)
         os.replace(path + ".part", path)
         written.append((t, path))
     return written
-
-
-def _tile_of_block(plan: "TilePlan") -> np.ndarray:
-    owner = np.full(int(np.prod(plan.grid.blocks)), -1, np.int64)
-    nb = plan.grid.blocks
-    o = owner.reshape(nb[2], nb[1], nb[0])
-    for t, (bl, bh) in enumerate(plan.tiles):
-        o[bl[2]:bh[2], bl[1]:bh[1], bl[0]:bh[0]] = t
-    return owner
 
 
 # ---- the plan: grid and tiles -------------------------------------------------------------
@@ -326,33 +311,45 @@ def _evaluate_grid(surface: Surface, grid: Grid, blocks: np.ndarray) -> np.ndarr
 
 
 def _band_blocks(points: np.ndarray, grid: Grid, radius: float, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    """The blocks in [lo, hi) within `radius` of some point (by their boxes)."""
+    """The blocks in [lo, hi) within `radius` of some point (by their boxes). Points a chunk
+    at a time, each chunk's blocks made unique at once: the candidates never outnumber a
+    chunk's points by more than the blocks a ball touches."""
     size = BLOCK * grid.cell
-    a = np.floor((points - radius - grid.origin) / size).astype(np.int64)
-    b = np.floor((points + radius - grid.origin) / size).astype(np.int64)
-    found = []
-    span = int((b - a).max()) if len(points) else 0
-    for dz in range(span + 1):
-        for dy in range(span + 1):
-            for dx in range(span + 1):
-                c = a + np.array([dx, dy, dz])
-                ok = np.all((c <= b) & (c >= lo) & (c < hi), axis=1)
-                found.append(grid.block_key(c[ok]))
-    keys = np.unique(np.concatenate(found)) if found else np.zeros(0, np.int64)
-    return keys
+    found = [np.zeros(0, np.int64)]
+    for start in range(0, len(points), _CHUNK):
+        p = points[start:start + _CHUNK]
+        a = np.floor((p - radius - grid.origin) / size).astype(np.int64)
+        b = np.floor((p + radius - grid.origin) / size).astype(np.int64)
+        span = int((b - a).max())
+        chunk = []
+        for dz in range(span + 1):
+            for dy in range(span + 1):
+                for dx in range(span + 1):
+                    c = a + np.array([dx, dy, dz])
+                    ok = np.all((c <= b) & (c >= lo) & (c < hi), axis=1)
+                    chunk.append(np.unique(grid.block_key(c[ok])))
+        found.append(np.unique(np.concatenate(chunk)))
+    return np.unique(np.concatenate(found))
 
 
-def _pieces(xyz: np.ndarray, grid: Grid) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _pieces(xyz: np.ndarray, grid: Grid, which: np.ndarray) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The tile's points in pieces: occupied grid cubes joined across faces, edges and corners
-    (26-connected). Returns the occupied cubes' centres, their piece, and each point's piece.
-    A tile sees patches its margin cuts off from the rest, and orientation may turn each one
-    its own way: each piece gets its own flip in the reconciliation."""
+    (26-connected). Returns the occupied cubes' centres, their piece, and the piece of the
+    points `which` (indices). A tile sees patches its margin cuts off from the rest, and
+    orientation may turn each one its own way: each piece gets its own flip in the
+    reconciliation."""
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
-    cube = np.floor((xyz - grid.origin) / grid.cell).astype(np.int64)
     n = grid.cells + 3  # cube keys with room for the ±1 neighbours
-    key = (cube[:, 0] + 1) + n[0] * ((cube[:, 1] + 1) + n[1] * (cube[:, 2] + 1))
-    cubes, point_cube = np.unique(key, return_inverse=True)
+    key = np.zeros(len(xyz), np.int64)
+    for start in range(0, len(xyz), _CHUNK):  # a chunk and an axis at a time: no integer copy of the points
+        k = key[start:start + _CHUNK]
+        for d in (2, 1, 0):
+            k *= n[d]
+            k += np.floor((xyz[start:start + _CHUNK, d] - grid.origin[d]) / grid.cell).astype(np.int64) + 1
+    cubes = np.unique(key)
+    which_cube = np.searchsorted(cubes, key[which])
+    del key
     rows, cols = [np.arange(len(cubes))], [np.arange(len(cubes))]
     for dz in (-1, 0, 1):
         for dy in (-1, 0, 1):
@@ -371,7 +368,7 @@ def _pieces(xyz: np.ndarray, grid: Grid) -> Tuple[np.ndarray, np.ndarray, np.nda
     y = cubes // n[0] % n[1] - 1
     z = cubes // (n[0] * n[1]) - 1
     centres = grid.origin + (np.stack([x, y, z], axis=1) + 0.5) * grid.cell
-    return centres, label.astype(np.int64), label[point_cube].astype(np.int64)
+    return centres, label.astype(np.int64), label[which_cube].astype(np.int64)
 
 
 def _corner_pieces(centres: np.ndarray, cube_piece: np.ndarray, grid: Grid, blocks: np.ndarray) -> np.ndarray:
@@ -385,6 +382,22 @@ def _corner_pieces(centres: np.ndarray, cube_piece: np.ndarray, grid: Grid, bloc
     return cube_piece[nearest].reshape(len(blocks), _OWNED)
 
 
+def _memory() -> Tuple[int, int]:
+    """(resident bytes now, peak resident bytes so far) of this process; 0 where the system
+    does not say."""
+    try:
+        import resource
+        peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * (1 if sys.platform == "darwin" else 1024)
+    except ImportError:
+        peak = 0
+    try:
+        with open("/proc/self/statm") as f:
+            now = int(f.read().split()[1]) * os.sysconf("SC_PAGE_SIZE")
+    except OSError:
+        now = 0
+    return now, peak
+
+
 def _tile_surface(source: Any, plan: TilePlan, tile: int, params: Dict[str, Any], reverse: bool = False) -> Dict[str, Any]:
     """Phase 1 of a tile: its points, surface, band and corner values, the piece of each
     corner, and the normals of its overlap sample. `reverse` (tests) turns the tile's surface
@@ -393,11 +406,13 @@ def _tile_surface(source: Any, plan: TilePlan, tile: int, params: Dict[str, Any]
         source = _Source(array=source)
     clock = time.perf_counter()
     times: Dict[str, float] = {}
+    memory: Dict[str, Tuple[int, int]] = {}
 
     def lap(name):
         nonlocal clock
         now = time.perf_counter()
         times[name] = now - clock
+        memory[name] = _memory()
         clock = now
 
     g = plan.grid
@@ -407,22 +422,21 @@ def _tile_surface(source: Any, plan: TilePlan, tile: int, params: Dict[str, Any]
     idx, xyz = source.select(own_lo - plan.margin, own_hi + plan.margin)
     lap("read")
     keys = _band_blocks(xyz, g, plan.band_radius, bl, bh)
-    out: Dict[str, Any] = {"tile": tile, "points": len(idx), "keys": keys, "times": times}
+    out: Dict[str, Any] = {"tile": tile, "points": len(idx), "keys": keys, "times": times, "memory": memory}
     if len(keys) == 0:
         out.update(values=np.zeros((0, _OWNED), np.float32), labels=np.zeros((0, _OWNED), np.int32), pieces=0,
                    faces=np.zeros((0, 4), np.int64), shared=np.zeros(0, np.int64),
                    shared_pieces=np.zeros(0, np.int64), normals=np.zeros((0, 3), np.float32))
         return out
-    centres, cube_piece, point_piece = _pieces(xyz, g)
-    pieces = int(cube_piece.max()) + 1
     # Overlap points: those some other tile holds too. A subsample fixed by global index, so
     # both tiles pick the same points.
     inner = np.all((xyz >= own_lo + plan.margin) & (xyz < own_hi - plan.margin), axis=1)
     stride = max(1, source.count // (len(plan.tiles) * _SHARED_SAMPLE))
     shared = np.flatnonzero((~inner) & (idx % stride == 0))
     out["shared"] = idx[shared]
-    out["shared_pieces"] = point_piece[shared]
-    del idx, point_piece, inner
+    del idx, inner
+    centres, cube_piece, out["shared_pieces"] = _pieces(xyz, g, shared)
+    pieces = int(cube_piece.max()) + 1
     lap("pieces")
     with Surface(xyz, **params) as s:
         del xyz  # the surface holds its own copy: only it while fitting
@@ -989,6 +1003,12 @@ def reconstruct(path_or_array: Any, client: Any = None, *, tile_points: int = 2_
                          band_blocks=int(len(all_keys)), phase1_seconds=t1 - t0, pieces=int(offsets[-1]),
                          tile_seconds={k: round(sum(s["times"].get(k, 0.0) for s in summaries), 3)
                                        for k in ("read", "fit", "orient", "evaluate", "pieces", "votes")},
+                         # Per stage, the largest resident size a tile's process had at its end.
+                         tile_resident_bytes={k: max((s["memory"][k][0] for s in summaries if k in s["memory"]),
+                                                     default=0)
+                                              for k in ("read", "pieces", "fit", "orient", "evaluate", "votes")},
+                         tile_peak_bytes=max((max(p for _, p in s["memory"].values()) for s in summaries
+                                              if s["memory"]), default=0),
                          seconds=time.perf_counter() - t0)
         return result
     finally:
