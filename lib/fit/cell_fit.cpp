@@ -25,13 +25,6 @@ constexpr size_t kMaxSharpSupport = 64;
 constexpr double kThinPartVariation = 0.05;
 constexpr double kThinPartImprovement = 0.25;
 constexpr double kThinPartError = 0.25;
-// Where the height field misses ε, a cell that can split is split anyway (its children
-// decide); one that cannot (its ungrown ball holds under N_min points, as on sparse data)
-// stays a leaf whose one height field gives both sides of a thin part one normal, with no
-// finer cell to repair it. There a less curved support and a smaller gain suffice. Where the
-// height field passes ε, the same relaxation added stray pieces and handles on dense clouds.
-constexpr double kStuckThinPartVariation = 0.03;
-constexpr double kStuckThinPartImprovement = 0.5;
 // Around a thin part, the quadric's gradients on the support point both ways across it;
 // at a crease or a corner (a far-from-flat support of one side) nearly all point one way,
 // and a general quadric there only adds zero sets. This share of the support must have
@@ -82,21 +75,19 @@ CellFit fit_cell(const PointList &support, double radius, double epsilon, double
         if (two.shape.model == Model::two_sheets) return two;
         fit.unresolved_sheets = split.found;
     }
-    const bool misses = fit.error > epsilon;
     if (epsilon <= requested && support.size() <= kThinPartMaxSupport && fit.shape.model == Model::bivariate &&
-        pca.variation > (misses ? kStuckThinPartVariation : kThinPartVariation) &&
-        fit.error > kThinPartError * epsilon) {
+        pca.variation > kThinPartVariation && fit.error > kThinPartError * epsilon) {
         LocalShape general;
         general.model = Model::quadric;
         general.q = fit_general_quadric(sample, radius);
         const double e = taubin_error(general, no_pieces, support);
-        if (e < (misses ? kStuckThinPartImprovement : kThinPartImprovement) * fit.error &&
+        if (e < kThinPartImprovement * fit.error &&
             opposed_share(general.q, sample, pca.axes.col(0)) >= kThinPartOpposed) {
             fit.shape = general;
             // A cell that missed ε still splits as before, so the octree and the grid the
             // polygonizer sizes from its leaves do not coarsen (a part two spacings across
             // needs the fine grid); where it cannot split, the leaf keeps the quadric.
-            if (!misses) fit.error = e;
+            if (fit.error <= epsilon) fit.error = e;
         }
     }
 
