@@ -4,9 +4,9 @@
 // up to 8 blocks. The value is a function of the corner's position alone, so it is computed
 // once, stored, and every later block reads the same bits it would have computed.
 //
-// Storage is sparse: `step`³-corner groups of the blocks that may ask (the band blocks and
-// their neighbours on the + sides, which own the samples on the band's + faces). A sample
-// of another block is computed and not kept. Safe for concurrent use: two threads may
+// Storage is sparse: each block that may ask owns the (block_cubes / step)³ samples on its
+// − faces and inside it; the band blocks' neighbours on the + sides own those on the band's
+// + faces. A sample no block owns (on the grid's own + faces) is computed and not kept. Safe for concurrent use: two threads may
 // both compute a missing sample, and both store the same value.
 #pragma once
 
@@ -46,7 +46,6 @@ public:
     static constexpr double bytes_per_block_in_use(int block_cubes, int step) {
         return 8.0 * double(block_cubes / step) * double(block_cubes / step) * double(block_cubes / step) * sizeof(double);
     }
-    bool empty() const { return per_block_ == 0; }
 
 private:
     std::atomic<double> *slot(int64_t x, int64_t y, int64_t z);
