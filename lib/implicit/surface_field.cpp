@@ -82,7 +82,7 @@ double SurfaceField::value(const Eigen::Vector3d &x, Eigen::Vector3d *gradient) 
 }
 
 void SurfaceField::block_values(const LatticeBlock &block, const uint32_t *near, size_t near_count,
-                                const uint8_t *skip, double *values) const {
+                                const uint8_t *skip, double *values, FarValueCache *far_cache) const {
     const int n = block.n, C = n + 1, S = kFarStep, CC = n / S + 1;  // coarse lattice step and size
     auto local = [C](int i, int j, int k) { return size_t(i + C * (j + C * k)); };
 
@@ -125,7 +125,9 @@ void SurfaceField::block_values(const LatticeBlock &block, const uint32_t *near,
     auto far = [&](int i, int j, int k) {
         const size_t c = size_t(i / S + CC * (j / S + CC * (k / S)));
         if (!coarse_done[c]) {
-            coarse[c] = far_value(block.corner(i, j, k), nullptr);
+            auto sample = [&] { return far_value(block.corner(i, j, k), nullptr); };
+            coarse[c] = far_cache ? far_cache->value(block.start[0] + i, block.start[1] + j, block.start[2] + k, sample)
+                                  : sample();
             coarse_done[c] = 1;
         }
         return coarse[c];

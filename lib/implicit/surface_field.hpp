@@ -24,6 +24,7 @@
 #include <Eigen/Core>
 
 #include "geometry/point_set.hpp"
+#include "implicit/far_value_cache.hpp"
 #include "implicit/mpu_function.hpp"
 #include "implicit/point_measures.hpp"
 #include "implicit/smooth_field.hpp"
@@ -83,10 +84,11 @@ public:
     // whose (widened) trust ball may reach the block. Untrusted corners take the far field
     // sampled on the coarse lattice of every kFarStep-th corner and interpolated: its sign
     // only matters away from the data, where it varies slowly, and this costs 1/64 of the
-    // neighbour searches.
+    // neighbour searches. `far_cache` (may be null) keeps those samples for the blocks that
+    // share them (a lattice of kFarStep over the grid the blocks' `start`s index).
     static constexpr int kFarStep = 4;
     void block_values(const LatticeBlock &block, const uint32_t *near, size_t near_count, const uint8_t *skip,
-                      double *values) const;
+                      double *values, FarValueCache *far_cache = nullptr) const;
 
     // The trusted value at x (the caller knows x is trusted): the smooth field's where it
     // is defined, else the MPU blend's among `leaves`.

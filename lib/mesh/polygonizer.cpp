@@ -64,12 +64,13 @@ double mean_spacing(const PointMeasures &measures) {
 }
 
 // Memory model of polygonize, for GMPU_PARAM_MAX_MEMORY (upper estimates of the peak):
-//  - per grid block: the band flag, the far sign, the region label and flood-fill stack;
-//  - per band block: its id, its output record and point bucket;
+//  - per grid block: the band flag, the far sign, the region label and flood-fill stack,
+//    the far-sample cache's slot index;
+//  - per band block: its id, its output record and point bucket, its far samples;
 //  - per triangle: the block's vertices (key, position, gradient, votes: half a vertex per
 //    triangle, more on block borders), the weld's sort keys and remap, and the mesh.
-constexpr double kBytesPerGridBlock = 16;
-constexpr double kBytesPerBandBlock = 200;
+constexpr double kBytesPerGridBlock = 16 + FarValueCache::kBytesPerGridBlock;
+constexpr double kBytesPerBandBlock = 200 + FarValueCache::bytes_per_block_in_use(B, SurfaceField::kFarStep);
 // Before any triangle is made: a low estimate (a block the surface crosses makes about B²
 // of them, and the band is at least twice as thick as the surface), so that the check
 // never refuses what would fit; the triangles themselves are then counted as they come.
@@ -107,7 +108,7 @@ struct SubBlockLeaves {
 
 // Marching cubes over one band block.
 void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuckets &buckets, const std::vector<int64_t> &band,
-                      size_t band_index, int root_steps, BlockOutput &out) {
+                      size_t band_index, int root_steps, FarValueCache &far_cache, BlockOutput &out) {
     const int64_t block = band[band_index];
     constexpr int C = B + 1;  // corners along a block's side
     thread_local std::vector<double> value(C * C * C);
@@ -144,7 +145,7 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuck
     for (int d = 0; d < 3; ++d) lattice.start[d] = origin[d];
     lattice.n = B;
     for (int s = 0; s < 8; ++s) lattice.leaves[s] = &leaves.list[s];
-    f.block_values(lattice, near, near_count, touches_far ? forced.data() : nullptr, value.data());
+    f.block_values(lattice, near, near_count, touches_far ? forced.data() : nullptr, value.data(), &far_cache);
     std::fill(slot.begin(), slot.end(), -1);
 
     auto vertex = [&](int i, int j, int k, const mc::Edge &e) -> uint32_t {
@@ -274,11 +275,12 @@ Mesh polygonize(const SurfaceField &field, int resolution, const Params &params,
     grid_progress.poll(1.0);
 
     const PointBuckets buckets(g, band, f, grid_progress, 1.0);
+    FarValueCache far_cache(g.blocks, B, SurfaceField::kFarStep, band);
     progress.throw_if_cancelled();
     std::vector<BlockOutput> blocks(band.size());
     std::atomic<uint64_t> triangles{0};
     parallel_for(0, band.size(), workers, blocks_progress, [&](size_t i) {
-        polygonize_block(g, f, buckets, band, i, clean ? kRootSteps : 0, blocks[i]);
+        polygonize_block(g, f, buckets, band, i, clean ? kRootSteps : 0, far_cache, blocks[i]);
         const uint64_t made = blocks[i].triangles.size() / 3;
         const double so_far = double(triangles.fetch_add(made) + made);
         if (so_far > params.max_triangles)

@@ -184,10 +184,16 @@ def components_right(rows, who):
     return f"{sum(r[who]['components'] == r['truth']['components'] for r in have)}/{len(have)}" if have else "–"
 
 
+def polygonize_share(run):
+    """The polygonize stage's share of fit + orient + polygonize (issue 14's target: 25 %)."""
+    stages, total = run.get("stages") or {}, run.get("seconds")
+    return stages["polygonize"] / total if "polygonize" in stages and total else None
+
+
 def cloud_table(rows):
     head = ("| cloud | orientation | F@0.5% (peer · Poisson(gmpu)) | F@1% (peer · Poisson(gmpu)) "
             "| components (truth) | genus (truth) | watertight | σ̂ / σ (% of diag.) "
-            "| s gmpu · Poisson(gmpu) · peer |\n"
+            "| s gmpu (polygonize share) · Poisson(gmpu) · peer |\n"
             "|---|---:|---:|---:|---:|---:|:---:|---:|---:|\n")
     lines = []
     for r in rows:
@@ -210,7 +216,8 @@ def cloud_table(rows):
             f"| {fs[0]} | {fs[1]} | {g.get('components', '–')} ({t['components']}){mark(ch.get('topology'))} "
             f"| {genus} ({','.join(map(str, t['genus']))}) | {'yes' if g.get('watertight') else 'no'} "
             f"| {noise}{mark(ch.get('noise'))} "
-            f"| {g['seconds']:.2f} · {fmt(q.get('seconds'), '.2f')} · {fmt(peer.get('seconds'), '.1f')} |")
+            f"| {g['seconds']:.2f} ({fmt(polygonize_share(g), '.0%')}) · {fmt(q.get('seconds'), '.2f')} "
+            f"· {fmt(peer.get('seconds'), '.1f')} |")
     return head + "\n".join(lines) + "\n"
 
 
