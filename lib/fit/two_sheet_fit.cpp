@@ -37,11 +37,11 @@ constexpr double kFlatImprovement = 0.85;
 // misses it, and the two sheets' error (distances to the nearer sheet, so under about half
 // the gap) stays well inside it, under kLocalTwoError × ε. A coarse cell's shape misfit that
 // reads flat either passes ε already or splits into groups farther apart than that. Such
-// walls show in supports from kLocalMinSamples points,
-// flatter than the cloud-wide bar (kLocalKurtosis; the kurtosis of one noisy sheet spreads
-// by √(24 / n), 0.31 at 256 points, and smaller supports of a tube's curved, noisy side
-// read flat by chance), and at least kLocalRadius × ε wide: in a support only a couple of noise floors
-// across, detail of the noise's scale (gear teeth at 1 % noise) reads as two sheets too.
+// walls show in supports of kLocalMinSamples points or more, flatter than the cloud-wide
+// bar (kLocalKurtosis; the kurtosis of one noisy sheet spreads by √(24 / n), 0.31 at 256
+// points, and smaller supports on a tube's curved, noisy side read flat by chance), and at
+// least kLocalRadius × ε wide: in a support only a couple of noise floors across, detail of
+// the noise's scale (gear teeth at 1 % noise) reads as two sheets too.
 // Only flat supports (a height field fitted them): around a thin tube the single fit is a
 // general quadric closed around it, which two sheets in one frame would only worsen.
 constexpr double kLocalTwoError = 0.7;
