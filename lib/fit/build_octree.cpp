@@ -41,7 +41,7 @@ struct Builder {
     const Params &params;
     double epsilon;  // ε in normalised units
     double requested;  // the caller's ε, before the noise floor
-    bool close_sheets;  // look for sheets a few σ apart (two_sheet_fit.hpp)
+    CloseSheets close_sheets;  // where to look for sheets a few σ apart (two_sheet_fit.hpp)
     Workers &workers;
     Progress &progress;
     Octree tree;
@@ -294,8 +294,10 @@ Octree build_octree(const PointSet &points, const Params &params, double epsilon
                     Progress &progress, bool close_sheets) {
     // Sheets a few σ apart matter only where the noise, not the caller, sets ε.
     const double requested = requested_epsilon(points, params);
-    Builder b{points, params, epsilon, std::min(epsilon, requested), close_sheets && epsilon > requested, workers,
-              progress, {}};
+    const CloseSheets close = !(epsilon > requested) ? CloseSheets::off
+                              : close_sheets         ? CloseSheets::cloud
+                                                     : CloseSheets::local;
+    Builder b{points, params, epsilon, std::min(epsilon, requested), close, workers, progress, {}};
     return b.run();
 }
 

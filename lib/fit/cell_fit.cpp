@@ -51,7 +51,7 @@ const PointList &fit_sample(const PointList &support, PointList &buffer) {
 }  // namespace
 
 CellFit fit_cell(const PointList &support, double radius, double epsilon, double requested, const Params &params,
-                 bool close_sheets) {
+                 CloseSheets close_sheets) {
     thread_local PointList sample_buffer;
     const PointList &sample = fit_sample(support, sample_buffer);
     static const std::vector<PiecewiseShape> no_pieces;
@@ -71,7 +71,7 @@ CellFit fit_cell(const PointList &support, double radius, double epsilon, double
     if (fit.error > std::min(epsilon, requested)) {
         CellFit two;
         two.variation = fit.variation;
-        const SheetSplit split = fit_two_sheets(support, fit.shape, fit.error, radius, close_sheets, two);
+        const SheetSplit split = fit_two_sheets(support, fit.shape, fit.error, radius, close_sheets, epsilon, two);
         if (two.shape.model == Model::two_sheets) return two;
         fit.unresolved_sheets = split.found;
     }

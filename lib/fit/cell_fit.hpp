@@ -10,6 +10,13 @@ namespace gmpu {
 
 constexpr double kVariationThreshold = 0.25;
 
+// Where two sheets only a few σ of noise apart are looked for (two_sheet_fit.hpp): nowhere
+// (ε is not the noise floor), everywhere the noise estimate saw them cloud-wide (`cloud`),
+// or, where it did not, in supports that show them on their own (`local`): the estimate
+// reads the quietest neighbourhoods, and on a part that is mostly single-sheeted there (a
+// rotor's hub) it misses walls (the blades) that cover much of the rest.
+enum class CloseSheets { off, local, cloud };
+
 struct CellFit {
     LocalShape shape;
     PiecewiseShape piece;  // valid when shape.model is edge or corner
@@ -24,8 +31,8 @@ struct CellFit {
 // `epsilon` is ε in the same (normalised) units, `requested` the caller's ε before the noise
 // floor raised it: a fit worse than that is checked for two sheets (two_sheet_fit.hpp),
 // whose clean separation shows that the floor, not the data, let the fit pass.
-// `close_sheets`: also look for sheets only a few σ of noise apart.
+// `close_sheets`: where to also look for sheets only a few σ of noise apart.
 CellFit fit_cell(const PointList &support, double radius, double epsilon, double requested, const Params &params,
-                 bool close_sheets = false);
+                 CloseSheets close_sheets = CloseSheets::off);
 
 }  // namespace gmpu

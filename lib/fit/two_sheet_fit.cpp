@@ -31,6 +31,23 @@ constexpr double kFlatKurtosis = 2.45;
 constexpr double kFlatOverlap = 0.6;
 // Within a few σ, each sheet's noise keeps the two-sheet error near the single fit's.
 constexpr double kFlatImprovement = 0.85;
+// Without the noise estimate's cloud-wide evidence (CloseSheets::local), a support must
+// show close sheets on its own. ε is then the noise floor, 1.75 σ̂, about the 90 % quantile
+// of one noisy sheet's distances (the fit error): a single fit through a wall a few σ thick
+// misses it, and the two sheets' error (distances to the nearer sheet, so under about half
+// the gap) stays well inside it, under kLocalTwoError × ε. A coarse cell's shape misfit that
+// reads flat either passes ε already or splits into groups farther apart than that. Such
+// walls show in supports of kLocalMinSamples points or more, flatter than the cloud-wide
+// bar (kLocalKurtosis; the kurtosis of one noisy sheet spreads by √(24 / n), 0.31 at 256
+// points, and smaller supports on a tube's curved, noisy side read flat by chance), and at
+// least kLocalRadius × ε wide: in a support only a couple of noise floors across, detail of
+// the noise's scale (gear teeth at 1 % noise) reads as two sheets too.
+// Only flat supports (a height field fitted them): around a thin tube the single fit is a
+// general quadric closed around it, which two sheets in one frame would only worsen.
+constexpr double kLocalTwoError = 0.7;
+constexpr size_t kLocalMinSamples = 256;
+constexpr double kLocalKurtosis = 2.35;
+constexpr double kLocalRadius = 3.0;
 // Points of one sheet must lie this share of the gap inside the other sheet's positive side,
 // or the sheets cross within the support.
 constexpr double kClearance = 0.25;
@@ -142,7 +159,7 @@ bool fit_sheets(const PointList &pts, std::vector<int> &label, double radius, Qu
 }  // namespace
 
 SheetSplit fit_two_sheets(const PointList &support, const LocalShape &single, double single_error, double radius,
-                          bool close, CellFit &out) {
+                          CloseSheets close, double epsilon, CellFit &out) {
     SheetSplit split;
     static const std::vector<PiecewiseShape> no_pieces;
     PointList pts;
@@ -163,7 +180,13 @@ SheetSplit fit_two_sheets(const PointList &support, const LocalShape &single, do
     std::vector<int> label(pts.size());
     for (size_t i = 0; i < pts.size(); ++i) label[i] = r[i] > groups.threshold;
     const bool separated = groups.gap >= kSeparation * groups.spread;
-    const bool flat = close && !separated && pts.size() >= kFlatMinSamples && kurtosis(r) < kFlatKurtosis &&
+    const bool local_only = close == CloseSheets::local;
+    const bool may_be_flat =
+        close == CloseSheets::cloud
+            ? pts.size() >= kFlatMinSamples
+            : local_only && single.model == Model::bivariate && pts.size() >= kLocalMinSamples &&
+                  single_error > epsilon && radius >= kLocalRadius * epsilon;
+    const bool flat = may_be_flat && !separated && kurtosis(r) < (local_only ? kLocalKurtosis : kFlatKurtosis) &&
                       overlap(pts, label) > kFlatOverlap;
     if (!separated && !flat) return split;
     split.found = separated;
@@ -179,6 +202,7 @@ SheetSplit fit_two_sheets(const PointList &support, const LocalShape &single, do
     local.q = shape.part[0];  // a smooth stand-in, never used while piece ≥ 0
     const double error = taubin_error(local, table, support);
     if (!(error < (separated ? kImprovement : kFlatImprovement) * single_error)) return split;
+    if (!separated && local_only && !(error < kLocalTwoError * epsilon)) return split;  // a misfit's groups
     out.shape = local;
     out.piece = shape;
     out.error = error;

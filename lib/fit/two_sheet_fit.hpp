@@ -20,9 +20,10 @@ struct SheetSplit {
 // Looks for two sheets in `support` around the fitted `single` shape. Fills `out` with the
 // two-sheet model when one fits (its error below the single fit's); the split tells
 // whether two sheets were seen at all, fitted or not. `close`: also look for sheets only a
-// few σ of noise apart, which the noise estimate reports cloud-wide (on a cloud without
-// them, a flat support is more often a coarse cell's shape misfit).
+// few σ of noise apart (on a cloud without them, a flat support is more often a coarse
+// cell's shape misfit, so without the cloud-wide evidence the support must show more).
+// `epsilon`: the noise floor ε, which the local evidence is measured against.
 SheetSplit fit_two_sheets(const PointList &support, const LocalShape &single, double single_error, double radius,
-                          bool close, CellFit &out);
+                          CloseSheets close, double epsilon, CellFit &out);
 
 }  // namespace gmpu

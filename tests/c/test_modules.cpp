@@ -217,11 +217,42 @@ void two_noisy_sheets_in_one_support(void **) {
     }
     Params params;
     const double tight = 1e-4;
-    assert_true(fit_cell(wall, 1.5, tight, tight, params, true).shape.model == Model::two_sheets);
-    assert_true(fit_cell(single, 1.5, tight, tight, params, true).shape.model != Model::two_sheets);
-    assert_true(fit_cell(wave, 1.5, tight, tight, params, true).shape.model != Model::two_sheets);
-    // Only where the noise estimate saw such sheets.
-    assert_true(fit_cell(wall, 1.5, tight, tight, params, false).shape.model != Model::two_sheets);
+    const CloseSheets cloud = CloseSheets::cloud;
+    assert_true(fit_cell(wall, 1.5, tight, tight, params, cloud).shape.model == Model::two_sheets);
+    assert_true(fit_cell(single, 1.5, tight, tight, params, cloud).shape.model != Model::two_sheets);
+    assert_true(fit_cell(wave, 1.5, tight, tight, params, cloud).shape.model != Model::two_sheets);
+    // Only where ε is the noise floor.
+    assert_true(fit_cell(wall, 1.5, tight, tight, params, CloseSheets::off).shape.model != Model::two_sheets);
+}
+
+void two_noisy_sheets_without_cloud_evidence(void **) {
+    // A blade 3 σ thick in a small support (300 points, under the 384 the cloud-wide
+    // evidence asks for), on a cloud whose noise estimate did not see close sheets (it reads
+    // the quietest neighbourhoods: a rotor's hub, not its blades, and reads the blades'
+    // offset as 1.2 σ). ε is the noise floor, 1.75 σ̂: one sheet through the blade misses
+    // it, two sheets stay well inside it, so the support shows the two sheets on its own.
+    // A single noisy sheet passes ε; a single sheet as spread as the blade, or a wave, are
+    // not two sheets either.
+    std::mt19937_64 rng(43);
+    std::normal_distribution<double> g(0, 1);
+    std::uniform_real_distribution<double> u(-1, 1);
+    const double sigma = 0.02, half_gap = 1.5 * sigma, floor = 1.75 * 1.2 * sigma, tight = 1e-4;
+    PointList wall, single, spread, wave;
+    for (int i = 0; i < 300; ++i) {
+        const double x = u(rng), y = u(rng);
+        wall.emplace_back(x, y, (i % 2 ? half_gap : -half_gap) + sigma * g(rng));
+        single.emplace_back(x, y, sigma * g(rng));
+        spread.emplace_back(x, y, std::sqrt(sigma * sigma + half_gap * half_gap) * g(rng));
+        wave.emplace_back(x, y, 0.1 * std::sin(4.0 * x));
+    }
+    Params params;
+    const CloseSheets local = CloseSheets::local;
+    assert_true(fit_cell(wall, 1.5, floor, tight, params, local).shape.model == Model::two_sheets);
+    assert_true(fit_cell(single, 1.5, floor, tight, params, local).shape.model != Model::two_sheets);
+    assert_true(fit_cell(spread, 1.5, floor, tight, params, local).shape.model != Model::two_sheets);
+    assert_true(fit_cell(wave, 1.5, floor, tight, params, local).shape.model != Model::two_sheets);
+    // Without the local evidence rule these supports are below the cloud-wide size.
+    assert_true(fit_cell(wall, 1.5, floor, tight, params, CloseSheets::off).shape.model != Model::two_sheets);
 }
 
 void noise_estimate_ignores_sparse_detail(void **) {
@@ -848,6 +879,7 @@ int main(void) {
         cmocka_unit_test(noise_estimate_ignores_sparse_detail),
         cmocka_unit_test(noise_estimate_sees_through_a_noisy_wall),
         cmocka_unit_test(two_noisy_sheets_in_one_support),
+        cmocka_unit_test(two_noisy_sheets_without_cloud_evidence),
         cmocka_unit_test(point_set_validation),
         cmocka_unit_test(outliers_are_far_from_everything),
         cmocka_unit_test(clusters_are_groups_far_apart),
