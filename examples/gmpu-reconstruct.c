@@ -461,6 +461,7 @@ int main(int argc, char **argv) {
         rc = fail("bad input points");
         goto done;
     }
+    double t_points = now_seconds();
     double outliers = 0;
     if (!o.quiet && gmpu_surface_get_stat(surface, GMPU_STAT_OUTLIERS, &outliers) == GMPU_OK && outliers > 0)
         fprintf(stderr, "gmpu: %.0f outlier points (far from all others) %s\n", outliers,
@@ -481,6 +482,7 @@ int main(int argc, char **argv) {
     release_free_memory();
     if (gmpu_surface_polygonize(surface, &mesh) != GMPU_OK) { rc = fail("polygonize failed"); goto done; }
     release_free_memory();
+    double t_finish = now_seconds();
     if (!finish_mesh(&o, &mesh) || !colour_mesh(cloud, &mesh)) goto done;
     double t_write = now_seconds();
     mesh_vertices = gmpu_mesh_vertex_count(mesh);
@@ -501,11 +503,11 @@ int main(int argc, char **argv) {
                 "gmpu: %zu points, %.0f cells (%.0f leaves, depth %.0f) in %.0f connected group%s\n"
                 "gmpu: estimated noise %.3f%% of the diagonal, fitted to error %.3f%%\n"
                 "gmpu: mesh %zu vertices, %zu triangles at resolution %.0f -> %s\n"
-                "gmpu: time read %.3f s, fit %.3f s, orient %.3f s, polygonize %.3f s, write %.3f s, "
-                "total %.3f s\n",
+                "gmpu: time read %.3f s, points %.3f s, fit %.3f s, orient %.3f s, polygonize %.3f s, "
+                "finish %.3f s, write %.3f s, total %.3f s\n",
                 n, cells, leaves, depth, comps, comps == 1 ? "" : "s", 100 * noise, 100 * eps,
-                mesh_vertices, mesh_triangles, res, o.output, t_read - t_start, fit, orient, poly,
-                t_end - t_write, t_end - t_start);
+                mesh_vertices, mesh_triangles, res, o.output, t_read - t_start, t_points - t_read, fit,
+                orient, poly, t_write - t_finish, t_end - t_write, t_end - t_start);
     }
     rc = 0;
 

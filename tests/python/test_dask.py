@@ -148,6 +148,23 @@ def test_a_reversed_tile_is_reconciled(cloud, untiled, client):
         abs(broken.volume / untiled[0].volume - 1) > 0.01
 
 
+def test_an_inward_oriented_tile_is_refitted(cloud, untiled, client):
+    """Tile 3 fitted with its normals reversed (as an open patch's own orientation may come
+    out): the library's field is then reversed near its points but not away from them (its
+    far sign comes from the winding number, 0 outside), so flipping its values cannot put
+    it right; the driver refits the tile with the reconciled, outward normals."""
+    stats = {}
+    mesh = gd.reconstruct(cloud, client, tile_points=TILE_POINTS, resolution=untiled[1], threads=1,
+                          _invert_tiles=[3], stats=stats)
+    assert stats["refitted_tiles"] == [3]
+    assert edge_problems(mesh.faces) == (0, 0)
+    assert components_and_genus(mesh.faces, len(mesh.vertices)) == \
+        components_and_genus(untiled[0].faces, len(untiled[0].vertices))
+    assert abs(mesh.volume / untiled[0].volume - 1) < 0.01
+    diagonal = np.linalg.norm(cloud.max(0) - cloud.min(0))
+    assert chamfer(mesh.vertices, untiled[0].vertices) < 2e-3 * diagonal
+
+
 def test_plan_splits_on_block_boundaries(cloud):
     lo, hi = cloud.min(0), cloud.max(0)
     plan = gd.plan_tiles(cloud, len(cloud), lo, hi, tile_points=TILE_POINTS, resolution=128)

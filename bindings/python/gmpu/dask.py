@@ -398,10 +398,18 @@ def _memory() -> Tuple[int, int]:
     return now, peak
 
 
-def _tile_surface(source: Any, plan: TilePlan, tile: int, params: Dict[str, Any], reverse: bool = False) -> Dict[str, Any]:
+def _tile_surface(source: Any, plan: TilePlan, tile: int, params: Dict[str, Any], reverse: bool = False,
+                  piece_signs: Optional[np.ndarray] = None) -> Dict[str, Any]:
     """Phase 1 of a tile: its points, surface, band and corner values, the piece of each
     corner, and the normals of its overlap sample. `reverse` (tests) turns the tile's surface
-    over, as if its own orientation had guessed wrong."""
+    over, as if its own orientation had guessed wrong.
+
+    `piece_signs` (±1 per piece): the tile's own oriented normals times its piece's sign are
+    given to a second surface as known normals, and that surface's field is the tile's. The
+    driver refits so every tile whose pieces the reconciliation turned over: the library
+    takes the sign of its field away from the points from the winding number of the oriented
+    points (0 outside, 1 inside), so an inward-oriented patch has a field whose sign near
+    the points is reversed but whose sign farther out is not, and no flip puts both right."""
     if not isinstance(source, (_Source, _TileFiles)):
         source = _Source(array=source)
     clock = time.perf_counter()
@@ -435,19 +443,38 @@ def _tile_surface(source: Any, plan: TilePlan, tile: int, params: Dict[str, Any]
     shared = np.flatnonzero((~inner) & (idx % stride == 0))
     out["shared"] = idx[shared]
     del idx, inner
-    centres, cube_piece, out["shared_pieces"] = _pieces(xyz, g, shared)
+    if piece_signs is None:
+        centres, cube_piece, out["shared_pieces"] = _pieces(xyz, g, shared)
+    else:
+        centres, cube_piece, point_piece = _pieces(xyz, g, np.arange(len(xyz)))
+        out["shared_pieces"] = point_piece[shared]
     pieces = int(cube_piece.max()) + 1
     lap("pieces")
-    with Surface(xyz, **params) as s:
+    s = Surface(xyz, **params)
+    if piece_signs is None:
         del xyz  # the surface holds its own copy: only it while fitting
+    try:
         s.fit()
         lap("fit")
         s.orient()
         lap("orient")
+        if piece_signs is not None:
+            known = s.normals
+            signs = np.asarray(piece_signs, np.float64)
+            known *= signs[point_piece][:, None] if signs.ndim else signs
+            del point_piece
+            s.close()
+            s = Surface(xyz, normals=known, **params)
+            del known, xyz
+            s.fit()
+            s.orient()  # known normals: no belief propagation
+            lap("refit")
         blocks = g.block_of_key(keys)
         values = _evaluate_grid(s, g, blocks)
         lap("evaluate")
         normals = s.normals[shared]
+    finally:
+        s.close()
     if reverse:
         values, normals = -values, -normals
     labels = _corner_pieces(centres, cube_piece, g, blocks) if pieces > 1 else np.zeros(values.shape, np.int32)
@@ -891,7 +918,7 @@ def reconstruct(path_or_array: Any, client: Any = None, *, tile_points: int = 2_
                 band_cells: float = 3.0, margin_cells: float = 16.0, min_component_share: float = 0.001,
                 reconcile: bool = True, stats: Optional[Dict[str, Any]] = None, output: Optional[str] = None,
                 scratch: Optional[str] = None,
-                _flip_tiles: Sequence[int] = (), **params: Any) -> Any:
+                _flip_tiles: Sequence[int] = (), _invert_tiles: Sequence[int] = (), **params: Any) -> Any:
     """The closed, outward-oriented mesh of a cloud (a PLY/XYZ path — binary little-endian
     PLY is memory-mapped — or an n×3 array), reconstructed in tiles of about `tile_points`
     points on the Dask `client` (None: the current client, else a local one made for the
@@ -906,7 +933,8 @@ def reconstruct(path_or_array: Any, client: Any = None, *, tile_points: int = 2_
     worker sees), removed at the end. Other keywords are gmpu.Surface
     parameters for every tile. `stats`, if a dict, receives the plan's figures.
     `reconcile=False` keeps every tile's own orientation (for comparison: an open patch's
-    orientation is a guess); `_flip_tiles` (tests) turns those tiles' surfaces over."""
+    orientation is a guess); `_flip_tiles` (tests) turns those tiles' surfaces over (values
+    and normals alike), `_invert_tiles` (tests) fits those tiles with their normals reversed."""
     from distributed import Client, get_client
     own_client = scratch_dir = None
     if client is None:
@@ -945,8 +973,9 @@ def reconstruct(path_or_array: Any, client: Any = None, *, tile_points: int = 2_
                 for t, path in written:
                     files[t].append(path)
             tile_data = [_TileFiles(files[t], source.count) for t in range(len(plan.tiles))]
-        phase1 = [client.submit(_tile_surface, tile_data[t], plan, t, params, t in _flip_tiles, pure=False)
-                  for t in range(len(plan.tiles))]
+        inverted = {t: -1.0 for t in _invert_tiles}
+        phase1 = [client.submit(_tile_surface, tile_data[t], plan, t, params, t in _flip_tiles, inverted.get(t),
+                                pure=False) for t in range(len(plan.tiles))]
         summaries = client.gather([client.submit(_summary, f) for f in phase1])
         t1 = time.perf_counter()
         if reconcile:
@@ -956,6 +985,19 @@ def reconstruct(path_or_array: Any, client: Any = None, *, tile_points: int = 2_
             flip, group = np.ones(nodes, np.int64), np.zeros(nodes, np.int64)
         flip, labels, sign = far_signs(g, summaries, flip, group)
         offsets = piece_offsets(summaries)
+        # A tile with a piece turned over is refitted with outward normals (_tile_surface says
+        # why a flip of its values is not enough); its pieces then need no flip.
+        refit = [t for t in range(len(plan.tiles)) if reconcile and (flip[offsets[t]:offsets[t + 1]] < 0).any()]
+        for t in refit:
+            own = flip[offsets[t]:offsets[t + 1]] * (-1.0 if t in _flip_tiles else 1.0) * inverted.get(t, 1.0)
+            phase1[t] = client.submit(_tile_surface, tile_data[t], plan, t, params, False, own, pure=False)
+        for t, summary in zip(refit, client.gather([client.submit(_summary, phase1[t]) for t in refit])):
+            summaries[t] = summary
+            flip[offsets[t]:offsets[t + 1]] = 1
+        if refit:
+            flip, labels, sign = far_signs(g, summaries, flip, group)
+        if stats is not None:
+            stats["refitted_tiles"] = refit
         # Who owns each band block, for the neighbours' corner layers.
         all_keys = np.concatenate([s["keys"] for s in summaries])
         owner = np.concatenate([np.full(len(s["keys"]), t) for t, s in enumerate(summaries)])
