@@ -29,6 +29,9 @@ constexpr int kMaxIterations = 300;
 // distances, it need only be settled near the band's edge, and far from the points only
 // its sign matters; most of the solve's time would otherwise go there.
 constexpr int kOuterIterations = 120;
+// A re-solve of the band starts from the first solution, which differs only where the
+// normals changed.
+constexpr int kResolveIterations = 100;
 // Coarser levels of the cascade (each twice the previous step).
 constexpr int kCoarseLevels = 1;
 // The outer field's grid step, in fine steps: coarse enough to cover the whole box at a
@@ -60,7 +63,8 @@ SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, 
     auto outer = std::make_shared<SmoothField>();
     outer->h_ = kOuterSteps * spacing;
     Progress outer_progress = progress.slice(0.0, 0.1);
-    outer->solve(points, measures, min_trust, noise, max_memory, nullptr, nullptr, true, outer_progress);
+    outer->solve(points, measures, measures.blend_normals, min_trust, noise, max_memory, nullptr, nullptr, true,
+                 kOuterIterations, outer_progress);
     // The cascade: each coarser level (twice the step) solved first, its field the next
     // level's start.
     std::vector<double> steps{spacing};
@@ -72,21 +76,47 @@ SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, 
         level.h_ = steps[l];
         Progress slice = progress.slice(0.1 + (levels - 1 - double(l)) / levels * 0.1,
                                         0.1 + (levels - double(l)) / levels * 0.1);
-        level.solve(points, measures, min_trust, noise, max_memory, coarse.empty() ? nullptr : &coarse, outer.get(), false, slice);
+        level.solve(points, measures, measures.blend_normals, min_trust, noise, max_memory, coarse.empty() ? nullptr : &coarse,
+                    outer.get(), false, kMaxIterations, slice);
         coarse = std::move(level);
     }
     h_ = spacing;
     Progress fine = progress.slice(steps.size() > 1 ? 0.2 : 0.0, 1.0);
-    const double shift = solve(points, measures, min_trust, noise, max_memory, coarse.empty() ? nullptr : &coarse, outer.get(), false, fine);
+    const double shift = solve(points, measures, measures.blend_normals, min_trust, noise, max_memory,
+                               coarse.empty() ? nullptr : &coarse, outer.get(), false, kMaxIterations, fine);
     // The fine level's zero set is the surface: the outer field follows its shift, so the
     // two agree where one hands over to the other.
     for (double &v : outer->values_) v -= shift;
     outer_ = std::move(outer);
+    min_trust_ = min_trust;
 }
 
-double SmoothField::solve(const PointSet &points, const PointMeasures &measures, double min_trust, double noise,
-                          double max_memory, const SmoothField *coarse, const SmoothField *boundary, bool whole_box,
-                          Progress &progress) {
+SmoothField SmoothField::resolved(const PointSet &points, const PointMeasures &measures,
+                                  const std::vector<float> &normals, double noise, double max_memory,
+                                  Progress &progress) const {
+    SmoothField next;
+    if (empty()) return next;
+    next.h_ = h_;
+    next.min_trust_ = min_trust_;
+    // The outer field first: it holds the band's edge, and a misoriented patch's error lives
+    // in it as much as in the band (kept, the old outer field would pin the band's edge to
+    // the old normals' surface). Both start from the previous solution.
+    auto outer = std::make_shared<SmoothField>();
+    outer->h_ = outer_->h_;
+    Progress outer_progress = progress.slice(0.0, 0.3);
+    outer->solve(points, measures, normals, min_trust_, noise, max_memory, outer_.get(), nullptr, true, kOuterIterations,
+                 outer_progress);
+    Progress band_progress = progress.slice(0.3, 1.0);
+    const double shift = next.solve(points, measures, normals, min_trust_, noise, max_memory, this, outer.get(), false,
+                                    kResolveIterations, band_progress);
+    for (double &v : outer->values_) v -= shift;
+    next.outer_ = std::move(outer);
+    return next;
+}
+
+double SmoothField::solve(const PointSet &points, const PointMeasures &measures, const std::vector<float> &normals,
+                          double min_trust, double noise, double max_memory, const SmoothField *coarse,
+                          const SmoothField *boundary, bool whole_box, int iterations, Progress &progress) {
     const size_t n = points.size();
     auto radius = [&](size_t i) { return std::max(double(measures.trust_radius[i]), min_trust) + std::sqrt(3.0) * h_; };
     double widest = 0.0;
@@ -144,7 +174,7 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
         int64_t lo[3], hi[3];
         node_box(i, lo, hi);
         const Eigen::Vector3d p = points.point(i);
-        const Eigen::Vector3d nrm(measures.blend_normals[3 * i], measures.blend_normals[3 * i + 1], measures.blend_normals[3 * i + 2]);
+        const Eigen::Vector3d nrm(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);
         const double r = radius(i), r2 = r * r;
         for (int64_t z = lo[2]; z <= hi[2]; ++z)
             for (int64_t y = lo[1]; y <= hi[1]; ++y)
@@ -189,7 +219,7 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
                 const double length = field[size_t(u)].norm();
                 if (length > kAgreeing) field[size_t(u)] /= length;
             }
-    if (whole_box) {
+    if (whole_box && !coarse) {
         // Away from the points the start copies the nearest band node's (breadth first):
         // the exterior starts outside and enclosed regions on the side their band says,
         // which is about where the smooth solution settles (it is flat there).
@@ -323,7 +353,6 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
     Eigen::VectorXd z = inverse_diagonal.cwiseProduct(r), p = z;
     double rz = r.dot(z);
     const double target = kTolerance * kTolerance * std::max(rhs.squaredNorm(), 1e-300);
-    const int iterations = whole_box ? kOuterIterations : kMaxIterations;
     for (int it = 0; it < iterations && r.squaredNorm() > target; ++it) {
         progress.poll(0.45 + 0.55 * double(it) / iterations);
         apply(p, Ap);

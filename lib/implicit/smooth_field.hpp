@@ -25,7 +25,9 @@
 // field instead of its far sign wherever the band ends. The solve is cascadic: the same
 // problem on a grid twice as coarse gives the fine solve its start, so conjugate gradients
 // only have the fine detail left to converge (they converge slowly on the smooth,
-// long-range part).
+// long-range part). `resolved` solves the problem again from other normals (the field's own
+// at the points, pipeline/smooth_surface.cpp), outer field and band both, each started from
+// the previous solution.
 #pragma once
 
 #include <cstdint>
@@ -56,6 +58,11 @@ public:
     // false outside the outer field's box (f is then undefined).
     bool value(const Eigen::Vector3d &x, double &f, Eigen::Vector3d *gradient) const;
 
+    // The same problem solved again with `normals` (outward, 3 per point) in place of the
+    // blend's, on the same grid and band edge, started from this field.
+    SmoothField resolved(const PointSet &points, const PointMeasures &measures, const std::vector<float> &normals,
+                         double noise, double max_memory, Progress &progress) const;
+
     bool empty() const { return values_.empty(); }
     size_t unknowns() const { return values_.size(); }
     double spacing() const { return h_; }
@@ -64,9 +71,9 @@ private:
     static constexpr int B = 8;  // nodes per block side of the sparse storage
     // Returns the shift that made f's mean over the samples 0. `boundary` (may be null) gives
     // the band's edge its values; `whole_box` solves on every node of the box, not a band.
-    double solve(const PointSet &points, const PointMeasures &measures, double min_trust, double noise,
-                 double max_memory, const SmoothField *coarse, const SmoothField *boundary, bool whole_box,
-                 Progress &progress);
+    double solve(const PointSet &points, const PointMeasures &measures, const std::vector<float> &normals,
+                 double min_trust, double noise, double max_memory, const SmoothField *coarse,
+                 const SmoothField *boundary, bool whole_box, int iterations, Progress &progress);
     // The band's own value (the fine grid only).
     bool band_value(const Eigen::Vector3d &x, double &f, Eigen::Vector3d *gradient) const;
     int32_t node(int64_t x, int64_t y, int64_t z) const;  // unknown index, -1 outside the band
@@ -74,6 +81,7 @@ private:
 
     Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();
     double h_ = 0.0;
+    double min_trust_ = 0.0;
     int64_t nodes_[3] = {0, 0, 0};     // per axis
     int64_t blocks_[3] = {0, 0, 0};    // per axis
     std::vector<int32_t> block_slot_;  // per block: its slot in node_index_ (÷ B³), or -1

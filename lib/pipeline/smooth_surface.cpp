@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "mesh/polygonizer.hpp"
+#include "pipeline/smooth_normals.hpp"
 
 namespace gmpu {
 
@@ -15,6 +16,11 @@ constexpr double kSmoothFromNoise = 0.003;
 // The smooth grid is never finer than this many cubes along the longest side (the default
 // polygonize grid's own cap).
 constexpr int kMaxResolution = 1024;
+// From this estimated noise on (a fraction of the diagonal) the smooth field is solved a
+// second time from its own normals: there the blend's normals are noisy enough that their
+// smoothed version moves the surface; below it the second solve changes little and costs
+// as much.
+constexpr double kResolveFromNoise = 0.0075;
 
 double noise_fraction(const PointSet &points, double noise) {
     const double diagonal = points.world_diagonal() * points.normalisation().scale;  // normalised
@@ -45,8 +51,20 @@ std::shared_ptr<const SmoothField> solve_smooth_surface(const Params &params, co
                                                         const PointSet &points, const PointMeasures &measures,
                                                         double noise, Progress &progress) {
     const double h = 1.0 / smooth_resolution(tree, measures);
-    return std::make_shared<const SmoothField>(points, measures, h, 2.0 * h, noise_fraction(points, noise),
-                                               params.max_memory, progress);
+    const double noise_share = noise_fraction(points, noise);
+    Progress first_progress = progress.slice(0.0, 0.7), normals_progress = progress.slice(0.7, 0.75),
+             second_progress = progress.slice(0.75, 1.0);
+    SmoothField first(points, measures, h, 2.0 * h, noise_share, params.max_memory, first_progress);
+    // Solved again from its own normals at the points (where the neighbours agree): they
+    // are the blend's normals averaged over the field's neighbourhood, far less noisy than
+    // the blend's own at noise, and scattered flips are corrected.
+    if (noise_share < kResolveFromNoise) {
+        progress.report(1.0);
+        return std::make_shared<const SmoothField>(std::move(first));
+    }
+    const std::vector<float> normals = field_point_normals(first, points, measures, normals_progress);
+    return std::make_shared<const SmoothField>(
+        first.resolved(points, measures, normals, noise_share, params.max_memory, second_progress));
 }
 
 }  // namespace gmpu
