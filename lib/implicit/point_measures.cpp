@@ -1,5 +1,6 @@
 #include "implicit/point_measures.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "core/resize_reporting.hpp"
@@ -13,8 +14,56 @@ constexpr size_t kNeighbours = 8;
 // Trust extends this many k-th-neighbour distances from a point: enough to bridge the
 // gaps between samples so the trusted shell around the surface has no holes.
 constexpr double kTrustSpacings = 1.5;
+// On sparse clouds a leaf's fit holds few points and the blend extrapolates them: a few
+// spacings out its quadrics bulge or close into sheets the data never showed (blobs and
+// handles beside legs and horns). There the trust reaches only kSparseTrustSpacings, and the
+// far field (signed by the winding number) decides beyond. Sparsity is the median k-th
+// neighbour distance as a fraction of the bounding-box diagonal; the trust shrinks linearly
+// from kDenseSpacing to kSparseSpacing, so denser clouds keep their trust exactly.
+constexpr double kSparseTrustSpacings = 0.75;
+constexpr double kDenseSpacing = 0.0125, kSparseSpacing = 0.015;
+// Where another sheet faces a point (normals opposed past kOpposedNormals) the far field's
+// sign is unreliable (the winding number of two close sparse sheets is not decisive, the
+// nearest normals disagree): the point keeps its full trust and the blend, which fits both
+// sheets, decides. The other sheet is one that a point faces within kOpposedNear of the full
+// trust in any direction, or a parallel sheet across a gap under kOpposedGap of it (the
+// facing point lies further along the normal than across it): the far side of a curved
+// organic part a few spacings away is neither, and there the trust shrinks.
+constexpr double kOpposedNormals = -0.5, kOpposedNear = 0.375, kOpposedGap = 0.5;
 // Up to this many points, the areas come from every point's own neighbours.
 constexpr size_t kExactMeasureLimit = 1u << 17;
+
+void shrink_sparse_trust(const PointSet &points, const std::vector<float> &normals, Workers &workers,
+                         Progress &progress, std::vector<float> &trust_radius) {
+    if (trust_radius.empty() || normals.size() != 3 * trust_radius.size()) return;
+    std::vector<float> sorted(trust_radius);
+    std::nth_element(sorted.begin(), sorted.begin() + long(sorted.size() / 2), sorted.end());
+    const double diagonal = points.world_diagonal() * points.normalisation().scale;
+    if (!(diagonal > 0.0)) return;
+    const double sparsity = double(sorted[sorted.size() / 2]) / kTrustSpacings / diagonal;
+    if (!(sparsity > kDenseSpacing)) return;
+    const double t = std::min(1.0, (sparsity - kDenseSpacing) / (kSparseSpacing - kDenseSpacing));
+    const float scale = float(1.0 - t * (1.0 - kSparseTrustSpacings / kTrustSpacings));
+    const std::vector<float> full(trust_radius);
+    auto normal = [&](uint32_t i) { return Eigen::Vector3d(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]); };
+    parallel_for(0, trust_radius.size(), workers, progress, [&](size_t i) {
+        thread_local std::vector<uint32_t> idx;
+        idx.clear();
+        const Eigen::Vector3d p = points.point(i);
+        points.within(p, double(full[i]), idx);
+        const Eigen::Vector3d n = normal(uint32_t(i));
+        for (uint32_t j : idx) {
+            if (!(n.dot(normal(j)) < kOpposedNormals)) continue;
+            const Eigen::Vector3d d = points.point(j) - p;
+            const double along = std::fabs(n.dot(d)), across = (d - n.dot(d) * n).norm();
+            const bool near = d.norm() < kOpposedNear * double(full[i]);
+            const bool parallel_sheet = along > across && along < kOpposedGap * double(full[i]);
+            if (near || parallel_sheet) return;  // a second sheet near: keep the blend
+        }
+        trust_radius[i] = full[i] * scale;
+    }, 512);
+    progress.throw_if_cancelled();
+}
 
 // Area and trust radius of every point, from its k-th neighbour distance.
 void measure_areas(const Octree &tree, const PointSet &points, Workers &workers, Progress &progress,
@@ -48,6 +97,7 @@ void measure_areas(const Octree &tree, const PointSet &points, Workers &workers,
             for (uint32_t k = c.point_begin; k < c.point_end; ++k) set(tree.order[k], rk);
         }
     }
+    shrink_sparse_trust(points, out.normals, workers, progress, out.trust_radius);
     out.widest_trust = 0.0;
     for (float r : out.trust_radius) out.widest_trust = std::max(out.widest_trust, double(r));
 }

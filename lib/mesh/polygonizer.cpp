@@ -256,7 +256,7 @@ Mesh polygonize(const SurfaceField &field, int resolution, const Params &params,
     Progress grid_progress = progress.slice(0.0, 0.02), blocks_progress = progress.slice(0.02, 0.95),
              weld_progress = progress.slice(0.95, 0.97), cleanup_progress = progress.slice(0.97, 0.98),
              sharpen_progress = progress.slice(0.98, 0.99), cap_progress = progress.slice(0.99, 1.0);
-    const double h = 1.0 / resolution, min_trust = 2.0 * h;
+    const double h = 1.0 / resolution, min_trust = grid_min_trust(resolution);
     const bool clean = noise < kCleanNoise * h && mean_spacing(measures) < kDenseSpacing * h;
     // Before allocating anything: the grid alone, then with the band, must fit the budget.
     const double grid_blocks = BlockGrid::blocks_for(points, resolution, std::max(measures.widest_trust, min_trust));

@@ -22,6 +22,10 @@ namespace gmpu {
 // a thin wall's two sheets.
 int default_resolution(const Octree &tree, const PointMeasures &measures);
 
+// The grid widens every point's trust radius to at least this at `resolution` (two cubes,
+// so every cube the surface crosses has its corners trusted); `evaluate` widens it the same.
+inline double grid_min_trust(int resolution) { return 2.0 / resolution; }
+
 // `noise`: the fit's noise estimate σ̂ (normalised units). On clean, dense data (σ̂ well
 // under a cube, samples closer than a cube) vertices are put on f = 0 and onto sharp edges;
 // under noise or between sparse samples f's zero set is a rougher guess and the linear

@@ -108,7 +108,10 @@ bool Reconstruction::field_matches(const Params &params) const {
 
 void Reconstruction::evaluate(const Params &params, const double *xyz, size_t count, double *values,
                               double *gradients) const {
-    const SurfaceField f = field(params.level);
+    // The trust the polygonizer gives the grid at the mesh's resolution, so the surface f
+    // answers is the one the mesh shows.
+    const int resolution = params.resolution > 0 ? params.resolution : default_resolution(params);
+    const SurfaceField f = field(params.level).bounded(grid_min_trust(resolution), INFINITY);
     const Normalisation &norm = points.normalisation();
     Eigen::Vector3d g;
     for (size_t i = 0; i < count; ++i) {
