@@ -65,9 +65,11 @@ void shrink_sparse_trust(const PointSet &points, const std::vector<float> &norma
     progress.throw_if_cancelled();
 }
 
-// Area and trust radius of every point, from its k-th neighbour distance.
+// Area and trust radius of every point, from its k-th neighbour distance. Noise-limited fits
+// keep their full trust: there the neighbour distances measure the noise as much as the
+// spacing, and the smooth field, not the blend's extrapolation, is the surface.
 void measure_areas(const Octree &tree, const PointSet &points, Workers &workers, Progress &progress,
-                   PointMeasures &out) {
+                   bool noisy_fits, PointMeasures &out) {
     const size_t n = points.size();
     assign_reporting(out.area, n, progress);
     assign_reporting(out.trust_radius, n, progress);
@@ -97,7 +99,7 @@ void measure_areas(const Octree &tree, const PointSet &points, Workers &workers,
             for (uint32_t k = c.point_begin; k < c.point_end; ++k) set(tree.order[k], rk);
         }
     }
-    shrink_sparse_trust(points, out.normals, workers, progress, out.trust_radius);
+    if (!noisy_fits) shrink_sparse_trust(points, out.normals, workers, progress, out.trust_radius);
     out.widest_trust = 0.0;
     for (float r : out.trust_radius) out.widest_trust = std::max(out.widest_trust, double(r));
 }
@@ -151,7 +153,7 @@ PointMeasures measure_points(const MpuFunction &mpu, const PointSet &points, Wor
     out.normals = point_normals(mpu, points, workers, progress, noisy_fits, &out.blend_normals);
     // Areas and trust radii take no share of the bar: they cost little next to the normals.
     Progress areas_progress = progress.slice(1.0, 1.0);
-    measure_areas(mpu.tree(), points, workers, areas_progress, out);
+    measure_areas(mpu.tree(), points, workers, areas_progress, noisy_fits, out);
     return out;
 }
 
