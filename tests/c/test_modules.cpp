@@ -199,30 +199,42 @@ void noise_estimate_sees_through_a_noisy_wall(void **) {
     }
 }
 
+// Point sets on the plane z = 0 in [-1, 1]²: two noisy sheets half_gap either side of it
+// (a wall), one noisy sheet, one sheet as spread as the wall, and a clean wave.
+struct SheetClouds {
+    PointList wall, single, spread, wave;
+};
+
+SheetClouds sheet_clouds(int n, double sigma, double half_gap, uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<double> g(0, 1);
+    std::uniform_real_distribution<double> u(-1, 1);
+    SheetClouds c;
+    for (int i = 0; i < n; ++i) {
+        const double x = u(rng), y = u(rng);
+        c.wall.emplace_back(x, y, (i % 2 ? half_gap : -half_gap) + sigma * g(rng));
+        c.single.emplace_back(x, y, sigma * g(rng));
+        c.spread.emplace_back(x, y, std::sqrt(sigma * sigma + half_gap * half_gap) * g(rng));
+        c.wave.emplace_back(x, y, 0.1 * std::sin(4.0 * x));
+    }
+    return c;
+}
+
 void two_noisy_sheets_in_one_support(void **) {
     // Two parallel sheets only 2.4 σ apart: their residuals do not split into two groups,
     // but form a flat two-peaked mixture spread over the whole support. A single sheet with
     // the same spread of Gaussian noise, or a clean wave one quadric cannot follow, must
     // not be read as two.
-    std::mt19937_64 rng(41);
-    std::normal_distribution<double> g(0, 1);
-    std::uniform_real_distribution<double> u(-1, 1);
     const double sigma = 0.02, half_gap = 1.2 * sigma;
-    PointList wall, single, wave;
-    for (int i = 0; i < 1500; ++i) {
-        const double x = u(rng), y = u(rng);
-        wall.emplace_back(x, y, (i % 2 ? half_gap : -half_gap) + sigma * g(rng));
-        single.emplace_back(x, y, std::sqrt(sigma * sigma + half_gap * half_gap) * g(rng));
-        wave.emplace_back(x, y, 0.1 * std::sin(4.0 * x));
-    }
+    const SheetClouds c = sheet_clouds(1500, sigma, half_gap, 41);
     Params params;
     const double tight = 1e-4;
     const CloseSheets cloud = CloseSheets::cloud;
-    assert_true(fit_cell(wall, 1.5, tight, tight, params, cloud).shape.model == Model::two_sheets);
-    assert_true(fit_cell(single, 1.5, tight, tight, params, cloud).shape.model != Model::two_sheets);
-    assert_true(fit_cell(wave, 1.5, tight, tight, params, cloud).shape.model != Model::two_sheets);
+    assert_true(fit_cell(c.wall, 1.5, tight, tight, params, cloud).shape.model == Model::two_sheets);
+    assert_true(fit_cell(c.spread, 1.5, tight, tight, params, cloud).shape.model != Model::two_sheets);
+    assert_true(fit_cell(c.wave, 1.5, tight, tight, params, cloud).shape.model != Model::two_sheets);
     // Only where ε is the noise floor.
-    assert_true(fit_cell(wall, 1.5, tight, tight, params, CloseSheets::off).shape.model != Model::two_sheets);
+    assert_true(fit_cell(c.wall, 1.5, tight, tight, params, CloseSheets::off).shape.model != Model::two_sheets);
 }
 
 void two_noisy_sheets_without_cloud_evidence(void **) {
@@ -233,26 +245,16 @@ void two_noisy_sheets_without_cloud_evidence(void **) {
     // it, two sheets stay well inside it, so the support shows the two sheets on its own.
     // A single noisy sheet passes ε; a single sheet as spread as the blade, or a wave, are
     // not two sheets either.
-    std::mt19937_64 rng(43);
-    std::normal_distribution<double> g(0, 1);
-    std::uniform_real_distribution<double> u(-1, 1);
     const double sigma = 0.02, half_gap = 1.5 * sigma, floor = 1.75 * 1.2 * sigma, tight = 1e-4;
-    PointList wall, single, spread, wave;
-    for (int i = 0; i < 300; ++i) {
-        const double x = u(rng), y = u(rng);
-        wall.emplace_back(x, y, (i % 2 ? half_gap : -half_gap) + sigma * g(rng));
-        single.emplace_back(x, y, sigma * g(rng));
-        spread.emplace_back(x, y, std::sqrt(sigma * sigma + half_gap * half_gap) * g(rng));
-        wave.emplace_back(x, y, 0.1 * std::sin(4.0 * x));
-    }
+    const SheetClouds c = sheet_clouds(300, sigma, half_gap, 43);
     Params params;
     const CloseSheets local = CloseSheets::local;
-    assert_true(fit_cell(wall, 1.5, floor, tight, params, local).shape.model == Model::two_sheets);
-    assert_true(fit_cell(single, 1.5, floor, tight, params, local).shape.model != Model::two_sheets);
-    assert_true(fit_cell(spread, 1.5, floor, tight, params, local).shape.model != Model::two_sheets);
-    assert_true(fit_cell(wave, 1.5, floor, tight, params, local).shape.model != Model::two_sheets);
+    assert_true(fit_cell(c.wall, 1.5, floor, tight, params, local).shape.model == Model::two_sheets);
+    assert_true(fit_cell(c.single, 1.5, floor, tight, params, local).shape.model != Model::two_sheets);
+    assert_true(fit_cell(c.spread, 1.5, floor, tight, params, local).shape.model != Model::two_sheets);
+    assert_true(fit_cell(c.wave, 1.5, floor, tight, params, local).shape.model != Model::two_sheets);
     // Without the local evidence rule these supports are below the cloud-wide size.
-    assert_true(fit_cell(wall, 1.5, floor, tight, params, CloseSheets::off).shape.model != Model::two_sheets);
+    assert_true(fit_cell(c.wall, 1.5, floor, tight, params, CloseSheets::off).shape.model != Model::two_sheets);
 }
 
 void noise_estimate_ignores_sparse_detail(void **) {
