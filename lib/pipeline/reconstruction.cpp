@@ -38,6 +38,7 @@ void Reconstruction::discard_fit() {
     winding = WindingField();
     smooth.reset();
     orient_stats = {};
+    blend_grid = smooth_grid = 0;
 }
 
 void Reconstruction::fit(const Params &params, Progress &progress) {
@@ -80,6 +81,8 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
         Progress read_progress = smooth_progress.slice(1.0, 1.0);
         measures.normals = field_point_normals(*new_smooth, points, measures, read_progress);
     }
+    blend_grid = gmpu::default_resolution(tree, measures);
+    smooth_grid = smooth_resolution(tree, measures);
     finish(progress);
     smooth = std::move(new_smooth);
     signs = std::move(orientation.signs);
@@ -98,8 +101,9 @@ Mesh Reconstruction::polygonize(const Params &params, int resolution, Progress &
 }
 
 int Reconstruction::default_resolution(const Params &params) const {
-    return wants_smooth_surface(params, points, noise) ? smooth_resolution(tree, measures)
-                                                       : gmpu::default_resolution(tree, measures);
+    const bool wants_smooth = wants_smooth_surface(params, points, noise);
+    if (blend_grid > 0) return wants_smooth ? smooth_grid : blend_grid;
+    return wants_smooth ? smooth_resolution(tree, measures) : gmpu::default_resolution(tree, measures);
 }
 
 bool Reconstruction::field_matches(const Params &params) const {

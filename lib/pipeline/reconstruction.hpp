@@ -38,6 +38,9 @@ struct Reconstruction {
     // at the last orient or polygonize; null: the MPU blend.
     std::shared_ptr<const SmoothField> smooth;
     OrientStats orient_stats;
+    // The default grids of the last orient, blend's and smooth field's: evaluate asks for one
+    // on every call, and each is a pass over every cell and point.
+    int blend_grid = 0, smooth_grid = 0;
     double noise = 0.0, epsilon = 0.0;     // of the last fit, normalised units
 
     // Fit: noise estimate, ε, adaptive octree of local fits.
