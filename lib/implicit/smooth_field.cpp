@@ -34,6 +34,11 @@ constexpr int kOuterIterations = 120;
 constexpr int kResolveIterations = 100;
 // Coarser levels of the cascade (each twice the previous step).
 constexpr int kCoarseLevels = 1;
+// A point's splat reaches its trust radius, but never more than this many fine grid steps:
+// a point far from the others (a sparse patch, a stray cluster) would otherwise splat onto
+// a ball of (trust / h)³ nodes, and the band's size would follow the gaps in the data
+// instead of the points and the grid. Beyond it the outer field answers.
+constexpr double kMaxReachSteps = 12.0;
 // The outer field's grid step, in fine steps: coarse enough to cover the whole box at a
 // small cost, fine enough to keep a thin wall's two sides apart where it hands over.
 constexpr double kOuterSteps = 2.0;
@@ -59,9 +64,11 @@ int32_t SmoothField::node(int64_t x, int64_t y, int64_t z) const {
 SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, double spacing, double min_trust,
                          double noise, double max_memory, Progress &progress) {
     if (points.size() == 0) return;
+    max_reach_ = kMaxReachSteps * spacing;
     // The outer field: the same problem on a coarser grid over the whole box, solved first.
     auto outer = std::make_shared<SmoothField>();
     outer->h_ = kOuterSteps * spacing;
+    outer->max_reach_ = max_reach_;
     Progress outer_progress = progress.slice(0.0, 0.1);
     outer->solve(points, measures, measures.blend_normals, min_trust, noise, max_memory, nullptr, nullptr, true,
                  kOuterIterations, outer_progress);
@@ -74,6 +81,7 @@ SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, 
     for (size_t l = steps.size(); l-- > 1;) {
         SmoothField level;
         level.h_ = steps[l];
+        level.max_reach_ = max_reach_;
         Progress slice = progress.slice(0.1 + (levels - 1 - double(l)) / levels * 0.1,
                                         0.1 + (levels - double(l)) / levels * 0.1);
         level.solve(points, measures, measures.blend_normals, min_trust, noise, max_memory, coarse.empty() ? nullptr : &coarse,
@@ -98,11 +106,13 @@ SmoothField SmoothField::resolved(const PointSet &points, const PointMeasures &m
     if (empty()) return next;
     next.h_ = h_;
     next.min_trust_ = min_trust_;
+    next.max_reach_ = max_reach_;
     // The outer field first: it holds the band's edge, and a misoriented patch's error lives
     // in it as much as in the band (kept, the old outer field would pin the band's edge to
     // the old normals' surface). Both start from the previous solution.
     auto outer = std::make_shared<SmoothField>();
     outer->h_ = outer_->h_;
+    outer->max_reach_ = max_reach_;
     Progress outer_progress = progress.slice(0.0, 0.3);
     outer->solve(points, measures, normals, min_trust_, noise, max_memory, outer_.get(), nullptr, true, kOuterIterations,
                  outer_progress);
@@ -118,7 +128,9 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
                           double min_trust, double noise, double max_memory, const SmoothField *coarse,
                           const SmoothField *boundary, bool whole_box, int iterations, Progress &progress) {
     const size_t n = points.size();
-    auto radius = [&](size_t i) { return std::max(double(measures.trust_radius[i]), min_trust) + std::sqrt(3.0) * h_; };
+    auto radius = [&](size_t i) {
+        return std::min(std::max(double(measures.trust_radius[i]), min_trust), max_reach_) + std::sqrt(3.0) * h_;
+    };
     double widest = 0.0;
     for (size_t i = 0; i < n; ++i) widest = std::max(widest, radius(i));
     origin_ = points.box_min() - Eigen::Vector3d::Constant(widest + 2.0 * h_);

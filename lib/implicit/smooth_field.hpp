@@ -16,8 +16,10 @@
 // positive inside like the MPU blend. Values between grid nodes are trilinear; gradients
 // are central differences at the nodes, interpolated the same way.
 //
-// The band reaches every point's trust radius (widened to `min_trust`) plus a cell
-// diagonal, so wherever the surface field trusts the data a smooth value exists. Around it,
+// The band reaches every point's trust radius (widened to `min_trust`, and at most a fixed
+// number of grid steps, so the band's size is bounded by the points and the grid) plus a
+// cell diagonal, so wherever the surface field trusts the data a smooth value exists (the
+// outer field's, past a band cut short by that cap). Around it,
 // an outer field solves the same problem on a coarser grid over the whole box (no normals
 // away from the points: f settles flat there, as in screened Poisson), and the band's edge
 // takes its values (Dirichlet): a misoriented patch's error then relaxes into the space
@@ -82,6 +84,7 @@ private:
     Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();
     double h_ = 0.0;
     double min_trust_ = 0.0;
+    double max_reach_ = 0.0;          // the longest splat radius, before the cell diagonal
     int64_t nodes_[3] = {0, 0, 0};     // per axis
     int64_t blocks_[3] = {0, 0, 0};    // per axis
     std::vector<int32_t> block_slot_;  // per block: its slot in node_index_ (÷ B³), or -1

@@ -144,12 +144,41 @@ void resolved_follows_the_new_normals(void **) {
     assert_true(std::fabs(at_second - at_direct) < 0.25 * std::fabs(at_first - at_direct));
 }
 
+// A point's splat reaches its trust radius but at most a fixed number of grid steps: eight
+// points far apart, each trusting 0.6 of the box, would otherwise splat onto balls of
+// (0.6 / h)³ nodes that fill the box, and the band (and the solve's time) would follow
+// the gaps between the points instead of the points and the grid.
+void band_stays_near_scattered_points(void **) {
+    std::vector<double> xyz;
+    for (int k = 0; k < 8; ++k) xyz.insert(xyz.end(), {k & 1 ? 0.4 : -0.4, k & 2 ? 0.4 : -0.4, k & 4 ? 0.4 : -0.4});
+    const PointSet points = PointSet::from_array(xyz.data(), 8, 0, 1);
+    const Vector3d centre = 0.5 * (points.box_min() + points.box_max());
+    PointMeasures measures;
+    for (size_t i = 0; i < 8; ++i) {
+        const Vector3d out = (points.point(i) - centre).normalized();
+        for (int k = 0; k < 3; ++k) measures.blend_normals.push_back(float(out[k]));
+        measures.trust_radius.push_back(0.6f);
+        measures.area.push_back(0.1f);
+    }
+    measures.widest_trust = 0.6;
+    measures.normals = measures.blend_normals;
+    const double h = 1.0 / 64;
+    Progress quiet(nullptr, nullptr, GMPU_STAGE_ORIENT);
+    const SmoothField field(points, measures, h, 2.0 * h, 0.01, 1e10, quiet);
+    // Balls 16 steps wide, one per point, at most.
+    const double bound = 8 * 4.0 / 3.0 * M_PI * std::pow(16.0, 3);
+    print_message("# band unknowns %zu, bound %.0f\n", field.unknowns(), bound);
+    assert_false(field.empty());
+    assert_true(double(field.unknowns()) <= bound);
+}
+
 }  // namespace
 
 int main() {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(misoriented_cap_relaxes_outside),
         cmocka_unit_test(resolved_follows_the_new_normals),
+        cmocka_unit_test(band_stays_near_scattered_points),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
