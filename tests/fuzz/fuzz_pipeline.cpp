@@ -2,11 +2,19 @@
 // polygonize → evaluate / copy_normals, on small point sets (n ≤ 200) derived from the
 // input bytes: exact duplicates, NaN / inf / subnormal / huge / tiny coordinates,
 // collinear, coplanar and spherical layouts, at scales from 1e-30 to 1e30, with random
-// parameters (MAX_CELLS and the resolution kept small, so each run takes milliseconds).
+// parameters (MAX_CELLS, the resolution and the memory budget kept small, so most runs take
+// milliseconds; the smooth field's solve, seconds in this build).
 //
 // A finding is: a crash, a sanitizer report, a status the header does not document for
 // that call (GMPU_ERROR_INTERNAL above all), a failure without a message, a mesh that is
-// not closed and consistently wound, or a non-finite value where finite input went in.
+// not closed and consistently wound, a non-finite value where finite input went in, or a
+// run over its CPU budget (work not bounded by the points, cells and grid it was given).
+//
+// The budget is the process's CPU time, not the wall clock: the fuzzer often shares its
+// machine with other jobs, and a unit that waited for a core did no extra work.
+// run.sh gives libFuzzer's wall-clock -timeout a wide margin over it, to catch hangs only.
+#include <time.h>
+
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -34,6 +42,24 @@ void check_failure(gmpu_status st, std::initializer_list<gmpu_status> allowed, c
     if (std::strncmp(msg, gmpu_status_name(st), std::strlen(gmpu_status_name(st))) != 0 ||
         std::strlen(msg) < std::strlen(gmpu_status_name(st)) + 4)
         finding("failure without a proper message", st);
+}
+
+// CPU seconds (every thread of the process) one input may take in the sanitizer build;
+// GMPU_FUZZ_CPU_BUDGET overrides it (a tighter budget finds the slowest inputs faster).
+double cpu_budget_seconds() {
+    static const double budget = [] {
+        const char *text = std::getenv("GMPU_FUZZ_CPU_BUDGET");
+        return text ? std::atof(text) : 60.0;
+    }();
+    return budget;
+}
+
+constexpr double kMaxMemoryBytes = 16e6;
+
+double process_cpu_seconds() {
+    timespec t{};
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
 }
 
 class Bytes {
@@ -159,9 +185,7 @@ void check_mesh(const gmpu_mesh *m) {
     }
 }
 
-}  // namespace
-
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
+void run_pipeline(const uint8_t *data, size_t size) {
     Bytes in(data, size);
     const size_t n = in.u8() % 201;
     const uint8_t flags = in.u8(), knobs = in.u8();
@@ -171,8 +195,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
 
     gmpu_surface *s = nullptr;
     if (gmpu_surface_create(&s) != GMPU_OK) finding("create");
-    // Small and fast: few cells, a coarse grid, one thread (libFuzzer runs one input at a time).
+    // Small and fast: few cells, a coarse grid, at most two threads, and a memory budget that
+    // also bounds the smooth field's solve (orient then fails with LIMIT_EXCEEDED, as
+    // documented, where a scattered cloud would ask for a wide band).
     if (gmpu_surface_set_param(s, GMPU_PARAM_MAX_CELLS, 2000 + 50 * (knobs & 63)) != GMPU_OK ||
+        gmpu_surface_set_param(s, GMPU_PARAM_MAX_MEMORY, kMaxMemoryBytes) != GMPU_OK ||
         gmpu_surface_set_param(s, GMPU_PARAM_RESOLUTION, 8 + 8 * (flags & 1)) != GMPU_OK ||
         gmpu_surface_set_param(s, GMPU_PARAM_MAX_TRIANGLES, 20000) != GMPU_OK ||
         gmpu_surface_set_param(s, GMPU_PARAM_THREADS, 1 + (flags >> 7)) != GMPU_OK ||
@@ -209,7 +236,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
                           "set_normals");
         }
         st = gmpu_surface_orient(s);
-        check_failure(st, {}, "orient");
+        check_failure(st, {GMPU_ERROR_LIMIT_EXCEEDED}, "orient");
     }
     gmpu_mesh *mesh = nullptr;
     if (st == GMPU_OK) {
@@ -247,5 +274,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     }
     gmpu_mesh_destroy(mesh);
     gmpu_surface_destroy(s);
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
+    const double start = process_cpu_seconds();
+    run_pipeline(data, size);
+    if (process_cpu_seconds() - start > cpu_budget_seconds()) finding("over the CPU budget");
     return 0;
 }
