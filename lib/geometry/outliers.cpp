@@ -88,7 +88,7 @@ OutlierScan find_outliers(const T *xyz, size_t count, size_t stride, bool only_i
         for (int d = 0; d < 3; ++d) cloud.xyz[3 * i + d] = read_coordinate<T>(bytes + i * stride, d);
     DoubleTree tree(3, cloud,
                     nanoflann::KDTreeSingleIndexAdaptorParams(16, nanoflann::KDTreeSingleIndexAdaptorFlags::SkipInitialBuildIndex));
-    std::vector<std::unique_ptr<DoubleTree>> subtrees;  // own the nodes of a parallel build
+    std::vector<std::unique_ptr<nanoflann::PooledAllocator>> subtrees;  // the nodes of a parallel build
     const bool parallel = workers && workers->threads() > 1 && count >= kParallelScanPoints;
     if (parallel)
         build_kdtree_in_parallel(tree, subtrees, *workers);

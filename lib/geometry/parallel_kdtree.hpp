@@ -5,12 +5,14 @@
 //
 // The top levels are split level by level with nanoflann's own middleSplit_, the nodes of
 // one level in parallel (their point ranges are disjoint). Below them each subtree is built
-// by nanoflann's divideTree on a helper tree — the node pool is not thread-safe, so each
-// helper allocates its own nodes — over a copy of the subtree's slice of the point order;
-// the slice is then copied back and the leaves' ranges shifted to where the slice sits.
-// Last, the top nodes take their children's tight bounds, bottom-up, as divideTree does.
+// on one thread by divide_subtree, nanoflann's divideTree step for step (middleSplit_ for
+// the splits) but taking its nodes from a pool of its own: the tree's pool is not
+// thread-safe. Last, the top nodes take their children's tight bounds, bottom-up, as
+// divideTree does. Nothing is copied: every thread reorders its own range of the tree's
+// point order in place.
 #pragma once
 
+#include <algorithm>
 #include <cstddef>
 #include <memory>
 #include <vector>
@@ -22,18 +24,59 @@
 
 namespace gmpu {
 
-// Builds `tree` on `workers`. The helpers own the subtrees' nodes: `helpers` must live as
-// long as the tree (it is cleared first). Cost: the serial build's, shared among the
-// threads but for the root's split (one pass over the points).
+// The nodes of points [left, right) of the tree's point order, taken from `pool`: what
+// nanoflann's divideTree makes of them (bbox in: the bounds it is handed; out: the tight ones).
 template <class Tree>
-void build_kdtree_in_parallel(Tree &tree, std::vector<std::unique_ptr<Tree>> &helpers, Workers &workers) {
+typename Tree::NodePtr divide_subtree(Tree &tree, nanoflann::PooledAllocator &pool, typename Tree::Offset left,
+                                      typename Tree::Offset right, typename Tree::BoundingBox &bbox) {
+    using Dimension = typename Tree::Dimension;
+    const Dimension dims = Dimension(bbox.size());
+    typename Tree::NodePtr node = pool.template allocate<typename Tree::Node>();
+    if (right - left <= typename Tree::Offset(tree.m_leaf_max_size)) {
+        node->child1 = node->child2 = nullptr;
+        node->node_type.lr.left = left;
+        node->node_type.lr.right = right;
+        for (Dimension i = 0; i < dims; ++i) bbox[i].low = bbox[i].high = tree.dataset_get(tree, tree.vAcc[left], i);
+        for (auto k = left + 1; k < right; ++k)
+            for (Dimension i = 0; i < dims; ++i) {
+                const auto v = tree.dataset_get(tree, tree.vAcc[k], i);
+                bbox[i].low = std::min(bbox[i].low, v);
+                bbox[i].high = std::max(bbox[i].high, v);
+            }
+        return node;
+    }
+    typename Tree::Offset split;
+    Dimension cutfeat;
+    typename Tree::DistanceType cutval;
+    tree.middleSplit_(tree, left, right - left, split, cutfeat, cutval, bbox);
+    node->node_type.sub.divfeat = cutfeat;
+    typename Tree::BoundingBox low(bbox), high(bbox);
+    low[cutfeat].high = cutval;
+    high[cutfeat].low = cutval;
+    node->child1 = divide_subtree(tree, pool, left, left + split, low);
+    node->child2 = divide_subtree(tree, pool, left + split, right, high);
+    node->node_type.sub.divlow = low[cutfeat].high;
+    node->node_type.sub.divhigh = high[cutfeat].low;
+    for (Dimension i = 0; i < dims; ++i) {
+        bbox[i].low = std::min(low[i].low, high[i].low);
+        bbox[i].high = std::max(low[i].high, high[i].high);
+    }
+    return node;
+}
+
+// Builds `tree` on `workers`. The subtrees' nodes are in `pools`, which must live as long as
+// the tree (it is cleared first). Cost: the serial build's, shared among the threads but for
+// the root's split (one pass over the points).
+template <class Tree>
+void build_kdtree_in_parallel(Tree &tree, std::vector<std::unique_ptr<nanoflann::PooledAllocator>> &pools,
+                              Workers &workers) {
     using Offset = typename Tree::Offset;
     using BoundingBox = typename Tree::BoundingBox;
     using NodePtr = typename Tree::NodePtr;
     using Dimension = typename Tree::Dimension;
     using DistanceType = typename Tree::DistanceType;
 
-    helpers.clear();
+    pools.clear();
     // What buildIndex() does before divideTree.
     tree.m_size = tree.dataset.kdtree_get_point_count();
     tree.init_vind();
@@ -93,29 +136,11 @@ void build_kdtree_in_parallel(Tree &tree, std::vector<std::unique_ptr<Tree>> &he
         frontier.swap(next);
     }
 
-    helpers.resize(frontier.size());
+    pools.resize(frontier.size());
     parallel_for(0, frontier.size(), workers, silent, [&](size_t k) {
         Task &task = tasks[frontier[k]];
-        auto helper = std::make_unique<Tree>(
-            tree.dim, tree.dataset,
-            nanoflann::KDTreeSingleIndexAdaptorParams(leaf, nanoflann::KDTreeSingleIndexAdaptorFlags::SkipInitialBuildIndex));
-        helper->vAcc.assign(tree.vAcc.begin() + long(task.left), tree.vAcc.begin() + long(task.right));
-        task.node = helper->divideTree(*helper, 0, task.right - task.left, task.bbox);
-        std::copy(helper->vAcc.begin(), helper->vAcc.end(), tree.vAcc.begin() + long(task.left));
-        std::vector<NodePtr> stack{task.node};
-        while (!stack.empty()) {
-            NodePtr n = stack.back();
-            stack.pop_back();
-            if (!n->child1 && !n->child2) {
-                n->node_type.lr.left += task.left;
-                n->node_type.lr.right += task.left;
-            } else {
-                stack.push_back(n->child1);
-                stack.push_back(n->child2);
-            }
-        }
-        helper->vAcc = {};  // queries read the tree's point order, not the helper's
-        helpers[k] = std::move(helper);
+        pools[k] = std::make_unique<nanoflann::PooledAllocator>();
+        task.node = divide_subtree(tree, *pools[k], task.left, task.right, task.bbox);
     }, 1);
 
     for (size_t t = tasks.size(); t-- > 0;) {  // children come after their parent

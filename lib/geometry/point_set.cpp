@@ -84,7 +84,7 @@ std::string number(double v) {
 struct PointSet::Index {
     CloudAdaptor adaptor;
     KdTree tree;
-    std::vector<std::unique_ptr<KdTree>> subtrees;  // own the nodes of a parallel build
+    std::vector<std::unique_ptr<nanoflann::PooledAllocator>> subtrees;  // the nodes of a parallel build
     Index(const std::vector<float> &pts, const std::vector<uint32_t> *ids, Workers *workers)
         : adaptor{pts.data(), ids ? ids->size() : pts.size() / 3, ids ? ids->data() : nullptr},
           tree(3, adaptor,

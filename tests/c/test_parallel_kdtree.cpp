@@ -80,8 +80,8 @@ void parallel_build_is_the_serial_tree(void **) {
         for (unsigned threads : {1u, 2u, 5u}) {
             Workers workers(threads);
             Tree parallel(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16, kSkip));
-            std::vector<std::unique_ptr<Tree>> helpers;
-            build_kdtree_in_parallel(parallel, helpers, workers);
+            std::vector<std::unique_ptr<nanoflann::PooledAllocator>> pools;
+            build_kdtree_in_parallel(parallel, pools, workers);
             assert_true(parallel.vAcc == serial.vAcc);
             for (int d = 0; d < 3; ++d) {
                 assert_true(parallel.root_bbox[d].low == serial.root_bbox[d].low);
