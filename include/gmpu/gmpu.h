@@ -310,7 +310,8 @@ GMPU_API gmpu_status gmpu_surface_set_progress(gmpu_surface *surface, gmpu_progr
  * points than GMPU_PARAM_MIN_POINTS; a NaN or infinite coordinate, with its index; a
  * coordinate beyond ±1e300 or a cloud spanning less than 1e-300: they cannot be normalised;
  * points spaced below a millionth of their extent that do not form separate clusters), DEGENERATE_INPUT (all points identical, collinear or coplanar: they bound no volume),
- * OUT_OF_MEMORY. On failure the previous points are kept. Cost: O(n log n). */
+ * OUT_OF_MEMORY. On failure the previous points are kept. Cost: O(n log n); the kd-tree and
+ * the outlier scan run on GMPU_PARAM_THREADS threads (the same result on any number). */
 GMPU_API gmpu_status gmpu_surface_set_points_f64(gmpu_surface *surface, const double *xyz,
                                                  size_t count, size_t stride);
 GMPU_API gmpu_status gmpu_surface_set_points_f32(gmpu_surface *surface, const float *xyz,
