@@ -247,6 +247,8 @@ export declare class Surface {
     gradient(points: Points): Float64Array;
     /** gmpu_surface_copy_normals: the oriented unit normal of every input point (3 per point). */
     normals(): Float64Array;
+    /** gmpu_surface_copy_normals_at: the normals of the input points `indices` only (3 per index). */
+    normalsAt(indices: ArrayLike<number> | BigInt64Array): Float64Array;
     /** gmpu_surface_polygonize: the zero set as a closed mesh (copied into JS arrays). */
     polygonize(options?: PolygonizeOptions): Mesh;
     /**

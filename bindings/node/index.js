@@ -238,6 +238,7 @@ function toPath(p, what = 'path') {
 // A non-NULL pointer for empty input, so that the C library reports "too few points"
 // (INVALID_INPUT) rather than "xyz is NULL" for an empty array.
 const EMPTY_F64 = new Float64Array(3);
+const EMPTY_I64 = new BigInt64Array(1);
 const EMPTY_F32 = new Float32Array(3);
 const nonEmpty = (data) => (data.length > 0 ? data : data instanceof Float32Array ? EMPTY_F32 : EMPTY_F64);
 
@@ -427,6 +428,22 @@ export class Surface {
         const count = Number(n.surface_point_count(h));
         const out = new Float64Array(3 * count);
         check(n.surface_copy_normals(h, count > 0 ? out : EMPTY_F64, count));
+        return out;
+    }
+
+    /**
+     * Oriented unit normals of the input points `indices` (an array of integers, or a
+     * BigInt64Array): Float64Array, 3 per index, as normals() gives them.
+     */
+    normalsAt(indices) {
+        const idx = indices instanceof BigInt64Array ? indices : BigInt64Array.from(indices, (i) => {
+            if (!Number.isInteger(i)) throw new TypeError(`indices must be integers (got ${i})`);
+            return BigInt(i);
+        });
+        const h = this.#handle();
+        const out = new Float64Array(3 * idx.length);
+        check(lib().surface_copy_normals_at(h, idx.length > 0 ? idx : EMPTY_I64, idx.length,
+            idx.length > 0 ? out : EMPTY_F64));
         return out;
     }
 

@@ -22,9 +22,9 @@
  *     out of the solid.
  *   - Thread safety: different handles never share mutable state and may be used from
  *     different threads at once. On one surface handle, functions taking a const pointer
- *     (evaluate, copy_normals, get_param, get_stat, point_count, last_error) may run
- *     concurrently with each other; every other call on that handle needs exclusive
- *     access. Meshes and point sets never change after creation: all their accessors may
+ *     (evaluate, copy_normals, copy_normals_at, get_param, get_stat, point_count,
+ *     last_error) may run concurrently with each other; every other call on that handle
+ *     needs exclusive access. Meshes and point sets never change after creation: all their accessors may
  *     run concurrently; only destroy needs exclusive access. gmpu keeps no global mutable
  *     state; gmpu_last_error() is per thread; a progress callback runs only on the thread
  *     that called fit, orient or polygonize.
@@ -55,11 +55,12 @@
  *        colours of PLY points and of meshes (gmpu_points_colors, gmpu_points_create_with,
  *        gmpu_mesh_colors, gmpu_mesh_color_from_points); statistics' names
  *        (gmpu_stat_count, gmpu_stat_name); tiles on a shared grid
- *        (gmpu_surface_evaluate_grid, gmpu_grid_polygonize, gmpu_mesh_grid_keys). */
+ *        (gmpu_surface_evaluate_grid, gmpu_grid_polygonize, gmpu_mesh_grid_keys).
+ *   0.5: the normals of chosen points (gmpu_surface_copy_normals_at). */
 #define GMPU_VERSION_MAJOR 0
-#define GMPU_VERSION_MINOR 4
+#define GMPU_VERSION_MINOR 5
 #define GMPU_VERSION_PATCH 0
-#define GMPU_VERSION_NUMBER 400 /* MAJOR*10000 + MINOR*100 + PATCH */
+#define GMPU_VERSION_NUMBER 500 /* MAJOR*10000 + MINOR*100 + PATCH */
 #define GMPU_ABI_VERSION 1
 
 #ifdef __cplusplus
@@ -309,7 +310,8 @@ GMPU_API gmpu_status gmpu_surface_set_progress(gmpu_surface *surface, gmpu_progr
  * points than GMPU_PARAM_MIN_POINTS; a NaN or infinite coordinate, with its index; a
  * coordinate beyond ±1e300 or a cloud spanning less than 1e-300: they cannot be normalised;
  * points spaced below a millionth of their extent that do not form separate clusters), DEGENERATE_INPUT (all points identical, collinear or coplanar: they bound no volume),
- * OUT_OF_MEMORY. On failure the previous points are kept. Cost: O(n log n). */
+ * OUT_OF_MEMORY. On failure the previous points are kept. Cost: O(n log n); the kd-tree and
+ * the outlier scan run on GMPU_PARAM_THREADS threads (the same result on any number). */
 GMPU_API gmpu_status gmpu_surface_set_points_f64(gmpu_surface *surface, const double *xyz,
                                                  size_t count, size_t stride);
 GMPU_API gmpu_status gmpu_surface_set_points_f32(gmpu_surface *surface, const float *xyz,
@@ -356,7 +358,10 @@ GMPU_API gmpu_status gmpu_surface_orient(gmpu_surface *surface);
  * (beyond a few point spacings of every input point) f is the distance to the nearest
  * input point, signed by the winding number of the oriented points where it is clearly 0
  * or 1 and by the nearby points' normals elsewhere: never zero there, so no surface.
- * Honours GMPU_PARAM_LEVEL. Safe to call from several threads at once after orient.
+ * Honours GMPU_PARAM_LEVEL and GMPU_PARAM_RESOLUTION: near the data, trust is widened to two
+ * cubes of the grid polygonize would use (GMPU_PARAM_RESOLUTION, or the default one when it is
+ * 0), as polygonize widens it, so that f = 0 on the vertices of that mesh; changing the
+ * resolution can change f near the data. Safe to call from several threads at once after orient.
  * Errors: INVALID_ARGUMENT (NULL; a count whose 3 × count doubles overflow), WRONG_ORDER
  * (not oriented; or GMPU_PARAM_SURFACE changed since orient and no polygonize has made that
  * surface yet), INVALID_INPUT (a NaN or infinite query, with its index; outputs untouched). Cost: O(count × log cells). */
@@ -368,6 +373,17 @@ GMPU_API gmpu_status gmpu_surface_evaluate(const gmpu_surface *surface, const do
  * Errors: INVALID_ARGUMENT (NULL, count differs from the point count), WRONG_ORDER. */
 GMPU_API gmpu_status gmpu_surface_copy_normals(const gmpu_surface *surface, double *out,
                                                size_t count);
+
+/* Copies the oriented unit normals of the count input points indices[0..count) into out
+ * (3 × count doubles): for each, exactly what gmpu_surface_copy_normals gives it, without an
+ * array of every point's normal (a tile's worker wants a few of millions). Indices are input
+ * positions (0 ≤ index < gmpu_surface_point_count), in any order, repeats allowed; count 0
+ * does nothing. Since 0.5.
+ * Errors: INVALID_ARGUMENT (NULL surface; NULL indices or out with count > 0; an index
+ * negative or not below the point count, with its position; out untouched), WRONG_ORDER
+ * (not oriented). Cost: O(count × log outliers). */
+GMPU_API gmpu_status gmpu_surface_copy_normals_at(const gmpu_surface *surface, const int64_t *indices,
+                                                  size_t count, double *out);
 
 /* Extracts the zero set of f as a closed, edge-manifold, consistently wound triangle mesh
  * (counter-clockwise seen from outside), restricted to a band around the data so that

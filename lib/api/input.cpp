@@ -33,9 +33,10 @@ Error clusters(const gmpu::OutlierScan &scan) {
 // The points as given; when they look collinear or coplanar, says so unless they are
 // far-apart clusters (which look so from afar).
 template <class T>
-gmpu::PointSet points_or_clusters(const T *xyz, size_t count, size_t stride, size_t min_points) {
+gmpu::PointSet points_or_clusters(const T *xyz, size_t count, size_t stride, size_t min_points,
+                                  gmpu::Workers *workers) {
     try {
-        return gmpu::PointSet::from_array(xyz, count, stride, min_points);
+        return gmpu::PointSet::from_array(xyz, count, stride, min_points, workers);
     } catch (const Error &e) {
         if (e.status() != GMPU_ERROR_DEGENERATE_INPUT) throw;
         const gmpu::OutlierScan full = gmpu::find_outliers(xyz, count, stride, false);
@@ -48,7 +49,8 @@ gmpu::PointSet points_or_clusters(const T *xyz, size_t count, size_t stride, siz
 // nearest[k]: the kept point nearest to outlier k (its normal stands in for the outlier's).
 template <class T>
 gmpu::PointSet kept_points(const T *xyz, size_t count, size_t stride, size_t min_points,
-                           const std::vector<uint32_t> &outliers, std::vector<uint32_t> &nearest) {
+                           const std::vector<uint32_t> &outliers, std::vector<uint32_t> &nearest,
+                           gmpu::Workers *workers) {
     const size_t step = stride ? stride : 3 * sizeof(T);
     const auto *bytes = reinterpret_cast<const unsigned char *>(xyz);
     auto read = [&](size_t i, T v[3]) { std::memcpy(v, bytes + i * step, 3 * sizeof(T)); };
@@ -64,7 +66,7 @@ gmpu::PointSet kept_points(const T *xyz, size_t count, size_t stride, size_t min
         read(i, v);
         kept.insert(kept.end(), v, v + 3);
     }
-    gmpu::PointSet points = gmpu::PointSet::from_array(kept.data(), kept.size() / 3, 0, min_points);
+    gmpu::PointSet points = gmpu::PointSet::from_array(kept.data(), kept.size() / 3, 0, min_points, workers);
     points.set_outlier_count(outliers.size());
     std::vector<uint32_t> idx;
     std::vector<float> d2;
@@ -95,16 +97,16 @@ void check_array(const void *data, size_t count, size_t stride, size_t element, 
 
 template <class T>
 InputPoints input_points(const T *xyz, size_t count, size_t stride, size_t min_points, OutlierScan scan,
-                         bool remove_outliers) {
+                         bool remove_outliers, Workers *workers) {
     // The points' own spacing, not their bounding box, is the scale of the detail: one
     // octree in float coordinates resolves about a millionth of the extent.
     if (scan.spacing > 0.0 && scan.spacing < 1e-6 * scan.extent) throw clusters(scan);
     InputPoints in;
     if (remove_outliers && !scan.outliers.empty()) {
-        in.points = kept_points(xyz, count, stride, min_points, scan.outliers, in.nearest);
+        in.points = kept_points(xyz, count, stride, min_points, scan.outliers, in.nearest, workers);
         in.outliers = std::move(scan.outliers);
     } else {  // kept in the fit, but still reported
-        in.points = points_or_clusters(xyz, count, stride, min_points);
+        in.points = points_or_clusters(xyz, count, stride, min_points, workers);
         in.points.set_outlier_count(scan.outliers.size());
     }
     return in;
@@ -138,8 +140,8 @@ std::vector<float> unit_normals(const T *nxyz, size_t count, size_t stride, cons
     return unit;
 }
 
-template InputPoints input_points(const float *, size_t, size_t, size_t, OutlierScan, bool);
-template InputPoints input_points(const double *, size_t, size_t, size_t, OutlierScan, bool);
+template InputPoints input_points(const float *, size_t, size_t, size_t, OutlierScan, bool, Workers *);
+template InputPoints input_points(const double *, size_t, size_t, size_t, OutlierScan, bool, Workers *);
 template std::vector<float> unit_normals(const float *, size_t, size_t, const std::vector<uint32_t> &);
 template std::vector<float> unit_normals(const double *, size_t, size_t, const std::vector<uint32_t> &);
 

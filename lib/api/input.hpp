@@ -23,10 +23,11 @@ struct InputPoints {
 
 // count points, x y z each, stride bytes apart (0: packed), whose outlier scan is given.
 // remove_outliers false keeps the outliers in the points (still counted). Throws
-// INVALID_INPUT or DEGENERATE_INPUT (see gmpu_surface_set_points).
+// INVALID_INPUT or DEGENERATE_INPUT (see gmpu_surface_set_points). The kd-tree is built on
+// the workers' threads when given.
 template <class T>
 InputPoints input_points(const T *xyz, size_t count, size_t stride, size_t min_points, OutlierScan scan,
-                         bool remove_outliers);
+                         bool remove_outliers, Workers *workers = nullptr);
 
 // The unit normals of the points that are not outliers (3 floats each), from count normals
 // stride bytes apart (0: packed). Throws INVALID_INPUT naming a NaN, infinite or zero normal.

@@ -1,5 +1,6 @@
 // The C ABI of gmpu_surface: a state machine over the pipeline's stages
 // (points → fitted → oriented), each verb checking that the stage before it is done.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -106,7 +107,8 @@ gmpu_status set_points(gmpu_surface *s, const T *xyz, size_t count, size_t strid
         s->require_idle("gmpu_surface_set_points");
         gmpu::api::check_array(xyz, count, stride, 3 * sizeof(T), "xyz");
         const size_t min_points = size_t(s->params.min_points);
-        gmpu::OutlierScan scan = gmpu::find_outliers(xyz, count, stride);
+        gmpu::Workers &workers = s->workers(unsigned(s->params.threads));
+        gmpu::OutlierScan scan = gmpu::find_outliers(xyz, count, stride, true, &workers);
         const gmpu::Clusters groups = gmpu::find_clusters(xyz, count, stride, scan.outliers, min_points);
         if (groups.count > 1) {
             auto parts = std::make_unique<gmpu::api::SurfaceParts>(groups);
@@ -123,7 +125,8 @@ gmpu_status set_points(gmpu_surface *s, const T *xyz, size_t count, size_t strid
             return;
         }
         gmpu::api::InputPoints in =
-            gmpu::api::input_points(xyz, count, stride, min_points, std::move(scan), s->params.remove_outliers);
+            gmpu::api::input_points(xyz, count, stride, min_points, std::move(scan), s->params.remove_outliers,
+                                    &workers);
         s->discard_fit();
         s->parts.reset();
         s->points = std::move(in.points);
@@ -338,6 +341,35 @@ GMPU_API gmpu_status gmpu_surface_copy_normals(const gmpu_surface *s, double *ou
             else
                 from = kept++;
             for (int d = 0; d < 3; ++d) out[3 * i + d] = double(s->measures.normals[3 * from + d]);
+        }
+    });
+}
+
+GMPU_API gmpu_status gmpu_surface_copy_normals_at(const gmpu_surface *s, const int64_t *indices, size_t count,
+                                                  double *out) {
+    return guarded(nullptr, [&] {
+        require_arg(s, "surface");
+        if (count > 0) {
+            require_arg(indices, "indices");
+            require_arg(out, "out");
+        }
+        s->require_idle("gmpu_surface_copy_normals_at");
+        s->require(gmpu_surface::Stage::oriented, "gmpu_surface_copy_normals_at", "gmpu_surface_orient");
+        for (size_t j = 0; j < count; ++j)
+            if (indices[j] < 0 || uint64_t(indices[j]) >= s->input_count)
+                throw Error(GMPU_ERROR_INVALID_ARGUMENT, "indices[" + std::to_string(j) + "] = " +
+                                                             std::to_string(indices[j]) + " is not a point: there are " +
+                                                             std::to_string(s->input_count) + " points");
+        if (s->parts) return s->parts->copy_normals_at(indices, count, out);
+        for (size_t j = 0; j < count; ++j) {
+            const auto i = uint32_t(indices[j]);
+            // Kept points are numbered without the outliers before them; an outlier takes
+            // the normal of the kept point nearest to it (as copy_normals).
+            const auto before = std::lower_bound(s->outliers.begin(), s->outliers.end(), i);
+            const size_t from = before != s->outliers.end() && *before == i
+                                    ? s->outlier_nearest[size_t(before - s->outliers.begin())]
+                                    : i - size_t(before - s->outliers.begin());
+            for (int d = 0; d < 3; ++d) out[3 * j + d] = double(s->measures.normals[3 * from + d]);
         }
     });
 }

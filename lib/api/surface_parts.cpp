@@ -173,6 +173,29 @@ void SurfaceParts::copy_normals(double *out, size_t) const {
     }
 }
 
+void SurfaceParts::copy_normals_at(const int64_t *indices, size_t count, double *out) const {
+    // Per cluster: which of the asked points are its members, and their positions in it.
+    std::vector<std::vector<int64_t>> local(parts_.size());
+    std::vector<std::vector<size_t>> asked(parts_.size());
+    for (size_t j = 0; j < count; ++j) {
+        const auto i = uint32_t(indices[j]);
+        for (size_t k = 0; k < parts_.size(); ++k) {
+            const auto at = std::lower_bound(members_[k].begin(), members_[k].end(), i);
+            if (at == members_[k].end() || *at != i) continue;
+            local[k].push_back(int64_t(at - members_[k].begin()));
+            asked[k].push_back(j);
+            break;
+        }
+    }
+    std::vector<double> own;
+    for (size_t k = 0; k < parts_.size(); ++k) {
+        if (local[k].empty()) continue;
+        own.resize(3 * local[k].size());
+        check(gmpu_surface_copy_normals_at(parts_[k], local[k].data(), local[k].size(), own.data()), k, size());
+        for (size_t m = 0; m < asked[k].size(); ++m) std::memcpy(out + 3 * asked[k][m], &own[3 * m], 3 * sizeof(double));
+    }
+}
+
 double SurfaceParts::stat(gmpu_stat key) const {
     if (key == GMPU_STAT_BBOX_DIAGONAL) return diagonal_;
     size_t largest = 0;

@@ -41,6 +41,8 @@ public:
     // Each query answered by the cluster whose box is nearest to it.
     void evaluate(const double *xyz, size_t count, double *values, double *gradients) const;
     void copy_normals(double *out, size_t count) const;
+    // The normals of the given input points (valid indices), each from its cluster.
+    void copy_normals_at(const int64_t *indices, size_t count, double *out) const;
     // Counts summed over the clusters, depth and resolution their maximum; the noise and ε
     // (fractions of a diagonal) are the largest cluster's; the diagonal the whole cloud's.
     double stat(gmpu_stat key) const;

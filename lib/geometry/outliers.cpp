@@ -3,10 +3,14 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <memory>
 
 #include <nanoflann.hpp>
 
+#include "core/parallel.hpp"
+#include "core/progress.hpp"
 #include "geometry/counting_result_set.hpp"
+#include "geometry/parallel_kdtree.hpp"
 
 namespace gmpu {
 
@@ -21,6 +25,9 @@ struct DoubleCloud {
 };
 using DoubleTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, DoubleCloud>,
                                                        DoubleCloud, 3, uint32_t>;
+
+// Fewer points scan on one thread: handing out the work would cost more.
+constexpr size_t kParallelScanPoints = 1u << 15;
 
 // Whether, on some axis, the bounding box is over kBulkFactor times as wide as the range
 // between the kBulkQuantile and 1 - kBulkQuantile quantiles of a sample: outliers that
@@ -66,7 +73,7 @@ double read_coordinate(const unsigned char *point, int d) {
 }  // namespace
 
 template <class T>
-OutlierScan find_outliers(const T *xyz, size_t count, size_t stride, bool only_if_box_is_wide) {
+OutlierScan find_outliers(const T *xyz, size_t count, size_t stride, bool only_if_box_is_wide, Workers *workers) {
     OutlierScan scan;
     if (stride == 0) stride = 3 * sizeof(T);
     const size_t k = kOutlierNeighbours;
@@ -79,8 +86,14 @@ OutlierScan find_outliers(const T *xyz, size_t count, size_t stride, bool only_i
     cloud.xyz.resize(3 * count);
     for (size_t i = 0; i < count; ++i)
         for (int d = 0; d < 3; ++d) cloud.xyz[3 * i + d] = read_coordinate<T>(bytes + i * stride, d);
-    DoubleTree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-    tree.buildIndex();
+    DoubleTree tree(3, cloud,
+                    nanoflann::KDTreeSingleIndexAdaptorParams(16, nanoflann::KDTreeSingleIndexAdaptorFlags::SkipInitialBuildIndex));
+    std::vector<std::unique_ptr<nanoflann::PooledAllocator>> subtrees;  // the nodes of a parallel build
+    const bool parallel = workers && workers->threads() > 1 && count >= kParallelScanPoints;
+    if (parallel)
+        build_kdtree_in_parallel(tree, subtrees, *workers);
+    else
+        tree.buildIndex();
 
     // Spacing: the median k-th neighbour distance (the point itself is the 0th) over a sample.
     constexpr size_t kSamples = 1024;
@@ -99,10 +112,20 @@ OutlierScan find_outliers(const T *xyz, size_t count, size_t stride, bool only_i
     if (!(spacing_sq > 0.0) || !std::isfinite(spacing_sq)) return scan;  // duplicates; the caller decides
 
     const double far_sq = kOutlierFar * kOutlierFar * spacing_sq;
-    for (size_t i = 0; i < count; ++i) {
+    auto is_far = [&](size_t i) {
         CountingResultSet<double> near{far_sq, k + 1};
         tree.findNeighbors(near, &cloud.xyz[3 * i], nanoflann::SearchParams(32, 0.0, false));
-        if (near.count < k + 1) scan.outliers.push_back(uint32_t(i));
+        return near.count < k + 1;
+    };
+    if (parallel) {  // one flag per point, collected in order: the serial answer
+        std::vector<uint8_t> far(count);
+        Progress silent(nullptr, nullptr, GMPU_STAGE_FIT);
+        parallel_for(0, count, *workers, silent, [&](size_t i) { far[i] = is_far(i); }, 4096);
+        for (size_t i = 0; i < count; ++i)
+            if (far[i]) scan.outliers.push_back(uint32_t(i));
+    } else {
+        for (size_t i = 0; i < count; ++i)
+            if (is_far(i)) scan.outliers.push_back(uint32_t(i));
     }
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     size_t next_outlier = 0;
@@ -120,7 +143,7 @@ OutlierScan find_outliers(const T *xyz, size_t count, size_t stride, bool only_i
     return scan;
 }
 
-template OutlierScan find_outliers<double>(const double *, size_t, size_t, bool);
-template OutlierScan find_outliers<float>(const float *, size_t, size_t, bool);
+template OutlierScan find_outliers<double>(const double *, size_t, size_t, bool, Workers *);
+template OutlierScan find_outliers<float>(const float *, size_t, size_t, bool, Workers *);
 
 }  // namespace gmpu

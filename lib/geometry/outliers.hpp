@@ -12,6 +12,8 @@
 
 namespace gmpu {
 
+class Workers;
+
 struct OutlierScan {
     std::vector<uint32_t> outliers;  // input indices, increasing; empty for most clouds
     double spacing = 0.0;            // typical distance to the k-th nearest neighbour
@@ -28,8 +30,10 @@ constexpr double kOutlierFar = 20.0;
 // With only_if_box_is_wide, the neighbour scan (a kd-tree over every point) runs only when
 // the bounding box is over twice as wide as the bulk of the points (their 1 %–99 % range on
 // some axis): outliers that do not widen the box so do not set the scale either, and most
-// clouds are spared the scan's cost.
+// clouds are spared the scan's cost. With workers, a large scan's kd-tree and neighbour test
+// run on their threads (the same answer).
 template <class T>
-OutlierScan find_outliers(const T *xyz, size_t count, size_t stride, bool only_if_box_is_wide = true);
+OutlierScan find_outliers(const T *xyz, size_t count, size_t stride, bool only_if_box_is_wide = true,
+                          Workers *workers = nullptr);
 
 }  // namespace gmpu

@@ -10,6 +10,7 @@
 
 #include "core/error.hpp"
 #include "geometry/counting_result_set.hpp"
+#include "geometry/parallel_kdtree.hpp"
 
 namespace gmpu {
 
@@ -83,9 +84,15 @@ std::string number(double v) {
 struct PointSet::Index {
     CloudAdaptor adaptor;
     KdTree tree;
-    explicit Index(const std::vector<float> &pts, const std::vector<uint32_t> *ids = nullptr)
-        : adaptor{pts.data(), ids ? ids->size() : pts.size() / 3, ids ? ids->data() : nullptr}, tree(3, adaptor, nanoflann::KDTreeSingleIndexAdaptorParams(16)) {
-        tree.buildIndex();
+    std::vector<std::unique_ptr<nanoflann::PooledAllocator>> subtrees;  // the nodes of a parallel build
+    Index(const std::vector<float> &pts, const std::vector<uint32_t> *ids, Workers *workers)
+        : adaptor{pts.data(), ids ? ids->size() : pts.size() / 3, ids ? ids->data() : nullptr},
+          tree(3, adaptor,
+               nanoflann::KDTreeSingleIndexAdaptorParams(16, nanoflann::KDTreeSingleIndexAdaptorFlags::SkipInitialBuildIndex)) {
+        if (workers && workers->threads() > 1 && adaptor.count >= kParallelBuildPoints)
+            build_kdtree_in_parallel(tree, subtrees, *workers);
+        else
+            tree.buildIndex();
     }
 };
 
@@ -95,7 +102,7 @@ PointSet &PointSet::operator=(PointSet &&) noexcept = default;
 PointSet::~PointSet() = default;
 
 template <class T>
-PointSet PointSet::from_array(const T *xyz, size_t count, size_t stride, size_t min_points) {
+PointSet PointSet::from_array(const T *xyz, size_t count, size_t stride, size_t min_points, Workers *workers) {
     if (stride == 0) stride = 3 * sizeof(T);
     if (count < min_points)
         throw Error(GMPU_ERROR_INVALID_INPUT,
@@ -166,15 +173,15 @@ PointSet PointSet::from_array(const T *xyz, size_t count, size_t stride, size_t 
     if (std::sqrt(ev[0]) < 1e-6)
         throw Error(GMPU_ERROR_DEGENERATE_INPUT,
                     "all points are coplanar (an open flat patch): no closed surface encloses a volume");
-    set.build_index();
+    set.build_index(workers);
     return set;
 }
 
-template PointSet PointSet::from_array<double>(const double *, size_t, size_t, size_t);
-template PointSet PointSet::from_array<float>(const float *, size_t, size_t, size_t);
+template PointSet PointSet::from_array<double>(const double *, size_t, size_t, size_t, Workers *);
+template PointSet PointSet::from_array<float>(const float *, size_t, size_t, size_t, Workers *);
 
-void PointSet::build_index() {
-    index_ = std::make_unique<Index>(points_);
+void PointSet::build_index(Workers *workers) {
+    index_ = std::make_unique<Index>(points_, nullptr, workers);
     const size_t n = size();
     if (n <= 2 * kCoarsePoints) return;
     // Every m-th point of a fixed pseudo-random order: uniform over the surface whatever
@@ -183,7 +190,7 @@ void PointSet::build_index() {
     for (uint32_t i = 0; i < n; ++i)
         if ((uint64_t(i) * 0x9E3779B97F4A7C15ull >> 32) % m == 0) coarse_ids_.push_back(i);
     coarse_ratio_ = double(n) / double(coarse_ids_.size());
-    coarse_index_ = std::make_unique<Index>(points_, &coarse_ids_);
+    coarse_index_ = std::make_unique<Index>(points_, &coarse_ids_, workers);
 }
 
 void PointSet::coarse_within(const Eigen::Vector3d &c, double radius, std::vector<uint32_t> &out) const {

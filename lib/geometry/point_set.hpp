@@ -13,6 +13,8 @@
 
 namespace gmpu {
 
+class Workers;
+
 // Maps caller coordinates to the normalised frame: q = (p - centre) * scale, so the
 // bounding box's longest side becomes 1 and its centre the origin.
 struct Normalisation {
@@ -26,8 +28,10 @@ class PointSet {
 public:
     // Validates and copies count points of type T (double or float), `stride` bytes apart.
     // Throws INVALID_INPUT (non-finite coordinate, too few points) or DEGENERATE_INPUT.
+    // With workers, a large set's kd-tree is built on their threads (the same tree).
     template <class T>
-    static PointSet from_array(const T *xyz, size_t count, size_t stride, size_t min_points);
+    static PointSet from_array(const T *xyz, size_t count, size_t stride, size_t min_points,
+                               Workers *workers = nullptr);
 
     PointSet();
     PointSet(PointSet &&) noexcept;
@@ -57,6 +61,8 @@ public:
     void coarse_within(const Eigen::Vector3d &centre, double radius, std::vector<uint32_t> &out) const;
     double coarse_ratio() const { return coarse_ratio_; }
     static constexpr size_t kCoarsePoints = 1u << 16;
+    // Fewer points build their kd-tree on one thread: handing out the work would cost more.
+    static constexpr size_t kParallelBuildPoints = 1u << 15;
 
     // Number of points within `radius`, stopping early once `enough` are found.
     size_t count_within(const Eigen::Vector3d &centre, double radius, size_t enough) const;
@@ -75,7 +81,7 @@ private:
     std::unique_ptr<Index> index_, coarse_index_;
     std::vector<uint32_t> coarse_ids_;
     double coarse_ratio_ = 1.0;
-    void build_index();
+    void build_index(Workers *workers);
 };
 
 }  // namespace gmpu

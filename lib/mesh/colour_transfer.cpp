@@ -21,8 +21,7 @@ using Tree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<do
 
 void transfer_colours(Mesh &mesh, const double *xyz, const uint8_t *colours, size_t count) {
     const BorrowedCloud cloud{xyz, count};
-    Tree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));
-    tree.buildIndex();
+    const Tree tree(3, cloud, nanoflann::KDTreeSingleIndexAdaptorParams(16));  // builds the index
     const size_t n = mesh.vertex_count();
     mesh.colors.resize(3 * n);
     for (size_t v = 0; v < n; ++v) {

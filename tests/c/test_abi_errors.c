@@ -145,6 +145,11 @@ static void test_wrong_order(void **state) {
     check_failure(gmpu_surface_polygonize(s, &m), GMPU_ERROR_WRONG_ORDER, "gmpu_surface_orient");
     check_failure(gmpu_surface_evaluate(s, q, 1, &val, NULL), GMPU_ERROR_WRONG_ORDER, "gmpu_surface_orient");
     check_failure(gmpu_surface_copy_normals(s, n, N_GOOD), GMPU_ERROR_WRONG_ORDER, "gmpu_surface_orient");
+    {
+        const int64_t first = 0;
+        check_failure2(gmpu_surface_copy_normals_at(s, &first, 1, n), GMPU_ERROR_WRONG_ORDER,
+                       "gmpu_surface_copy_normals_at", "gmpu_surface_orient");
+    }
 
     /* Fitted only. */
     assert_ok(gmpu_surface_fit(s));
@@ -450,6 +455,22 @@ static void test_parameters(void **state) {
     check_usable_and_destroy(s);
 }
 
+/* copy_normals_at on an index set with every kind of point (first, last, backwards,
+ * repeated, and `extra` more, e.g. outliers) gives copy_normals' rows bit for bit. */
+static void assert_normals_at_match(const gmpu_surface *s, size_t n, const int64_t *extra, size_t extra_count) {
+    double *all = malloc(3 * n * sizeof *all);
+    assert_ok(gmpu_surface_copy_normals(s, all, n));
+    int64_t idx[16] = {(int64_t)n - 1, 0, (int64_t)n / 2, 0, 1, (int64_t)n / 3};
+    size_t count = 6;
+    for (size_t k = 0; k < extra_count && count < 16; ++k) idx[count++] = extra[k];
+    double at[3 * 16];
+    for (size_t k = 0; k < 3 * 16; ++k) at[k] = NAN;
+    assert_ok(gmpu_surface_copy_normals_at(s, idx, count, at));
+    for (size_t k = 0; k < count; ++k) assert_memory_equal(at + 3 * k, all + 3 * idx[k], 3 * sizeof(double));
+    assert_ok(gmpu_surface_copy_normals_at(s, NULL, 0, NULL)); /* nothing asked: nothing done */
+    free(all);
+}
+
 static void test_evaluate_and_normals_errors(void **state) {
     (void)state;
     gmpu_surface *s = oriented_surface();
@@ -473,6 +494,19 @@ static void test_evaluate_and_normals_errors(void **state) {
                   "count 1999 differs from the 2000 points");
     check_failure(gmpu_surface_copy_normals(s, n, 0), GMPU_ERROR_INVALID_ARGUMENT, "count 0");
     assert_ok(gmpu_surface_copy_normals(s, n, N_GOOD));
+    /* Normals of chosen points: a bad index is named, and out is untouched. */
+    {
+        const int64_t bad[3] = {5, (int64_t)N_GOOD, 7}, negative[2] = {0, -1};
+        double at[9] = {7, 7, 7, 7, 7, 7, 7, 7, 7};
+        check_failure(gmpu_surface_copy_normals_at(s, bad, 3, at), GMPU_ERROR_INVALID_ARGUMENT,
+                      "indices[1] = 2000 is not a point: there are 2000 points");
+        check_failure(gmpu_surface_copy_normals_at(s, negative, 2, at), GMPU_ERROR_INVALID_ARGUMENT, "indices[1] = -1");
+        for (int k = 0; k < 9; ++k) assert_true(at[k] == 7);
+        check_failure(gmpu_surface_copy_normals_at(s, NULL, 1, at), GMPU_ERROR_INVALID_ARGUMENT, "indices is NULL");
+        check_failure(gmpu_surface_copy_normals_at(s, bad, 1, NULL), GMPU_ERROR_INVALID_ARGUMENT, "out is NULL");
+        check_failure(gmpu_surface_copy_normals_at(NULL, bad, 1, at), GMPU_ERROR_INVALID_ARGUMENT, "surface is NULL");
+        assert_normals_at_match(s, N_GOOD, NULL, 0);
+    }
     /* Outward on a sphere. */
     size_t outward = 0;
     for (size_t i = 0; i < N_GOOD; ++i) {
@@ -779,6 +813,10 @@ static void test_outliers_set_aside(void **state) {
                             3 * gmpu_mesh_vertex_count(m) * sizeof(double));
         /* Normals for every input point, the outliers included (unit length). */
         assert_ok(gmpu_surface_copy_normals(s, normals, n));
+        {
+            const int64_t outliers[2] = {(int64_t)N_GOOD + 1, (int64_t)N_GOOD};
+            assert_normals_at_match(s, n, outliers, 2);
+        }
         for (size_t i = N_GOOD; i < n; ++i) {
             const double *v = normals + 3 * i;
             assert_true(fabs(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] - 1) < 1e-6);
@@ -880,6 +918,10 @@ static void test_separate_clusters(void **state) {
     assert_true(components == 2 && points == 2 * N_GOOD && diag > 1e6);
     /* Normals in input order: outward on each sphere. */
     assert_ok(gmpu_surface_copy_normals(s, normals, 2 * N_GOOD));
+    {
+        const int64_t each_cluster[4] = {3, 2 * N_GOOD - 2, 2 * N_GOOD - 1, 1};
+        assert_normals_at_match(s, 2 * N_GOOD, each_cluster, 4);
+    }
     for (size_t i = 0; i < 2 * N_GOOD; ++i) {
         const double *c = i % 2 ? far_centre : kCentre, r = i % 2 ? 1000.0 : 1.0, *p = xyz + 3 * i, *n = normals + 3 * i;
         const double dot = ((p[0] - c[0]) * n[0] + (p[1] - c[1]) * n[1] + (p[2] - c[2]) * n[2]) / r;

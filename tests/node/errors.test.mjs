@@ -80,7 +80,16 @@ test('stages called in the wrong order', () => {
         s.fit();
         // Messages of const calls are their own, not the last failure of the surface.
         assert.throws(() => s.evaluate([[0, 0, 0]]), gmpuError('GMPU_ERROR_WRONG_ORDER', /evaluate/));
+        assert.throws(() => s.normalsAt([0]), gmpuError('GMPU_ERROR_WRONG_ORDER', /copy_normals_at needs .*orient/));
         s.orient();
+        // The normals of chosen points are rows of every point's; a bad index is named.
+        const all = s.normals(), n = all.length / 3;
+        const at = s.normalsAt([n - 1, 0, 5]);
+        assert.deepEqual(Array.from(at), [...all.slice(3 * (n - 1)), ...all.slice(0, 3), ...all.slice(15, 18)]);
+        assert.deepEqual(Array.from(s.normalsAt(new BigInt64Array([2n]))), Array.from(all.slice(6, 9)));
+        assert.equal(s.normalsAt([]).length, 0);
+        assert.throws(() => s.normalsAt([1, n]), gmpuError('GMPU_ERROR_INVALID_ARGUMENT', new RegExp(`indices\\[1\\] = ${n} is not a point`)));
+        assert.throws(() => s.normalsAt([0.5]), TypeError);
         // A fit parameter discards the fit (and so the orientation).
         s.setParam('error', 0.01);
         assert.throws(() => s.polygonize(), gmpuError('GMPU_ERROR_WRONG_ORDER'));

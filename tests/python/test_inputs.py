@@ -246,3 +246,17 @@ def test_set_params_is_all_or_nothing(oriented):
     with pytest.raises(gmpu.InvalidArgumentError, match="GMPU_PARAM_MAX_DEPTH"):
         oriented.set_params(error=0.01, max_depth=99)
     assert oriented.params == before and oriented.stats["cells"] == cells  # the fit was kept
+
+
+def test_normals_at_are_rows_of_normals(oriented, small_cloud):
+    n = len(small_cloud[0])
+    idx = np.array([n - 1, 0, 17, 17, n // 2], np.int64)
+    assert np.array_equal(oriented.normals_at(idx), oriented.normals[idx])
+    assert np.array_equal(oriented.normals_at(idx.astype(np.uint32)), oriented.normals[idx])
+    assert oriented.normals_at([]).shape == (0, 3)
+    with pytest.raises(gmpu.InvalidArgumentError, match=rf"indices\[1\] = {n} is not a point"):
+        oriented.normals_at([3, n])
+    with pytest.raises(gmpu.InvalidArgumentError, match=r"indices\[0\] = -1"):
+        oriented.normals_at([-1])
+    with pytest.raises(TypeError, match="integers"):
+        oriented.normals_at([0.5])

@@ -113,6 +113,7 @@ function declare(lib) {
         // Output arrays are typed arrays passed by pointer (koffi hands C their memory).
         surface_evaluate: f('int', 'gmpu_surface_evaluate', ['void *', 'double *', 'size_t', 'void *', 'void *']),
         surface_copy_normals: f('int', 'gmpu_surface_copy_normals', ['void *', 'void *', 'size_t']),
+        surface_copy_normals_at: f('int', 'gmpu_surface_copy_normals_at', ['void *', 'int64_t *', 'size_t', 'void *']),
         surface_polygonize: f('int', 'gmpu_surface_polygonize', ['void *', outPtr]),
 
         mesh_create: f('int', 'gmpu_mesh_create', ['double *', 'size_t', 'uint32_t *', 'size_t', outPtr]),

@@ -719,6 +719,23 @@ class Surface:
 
         return self._read(body)
 
+    def normals_at(self, indices: ArrayLike) -> NDArray[np.float64]:
+        """Oriented unit outward normals of the input points `indices` (len×3 float64, a fresh
+        array): rows of `normals`, without an array of every point's normal. Needs orient();
+        an index below 0 or not below the point count raises gmpu.InvalidArgumentError."""
+        idx = np.asarray(indices)
+        if idx.ndim != 1 or not (idx.dtype.kind in "iu" or idx.size == 0):
+            raise TypeError("indices must be a 1-d array of integers")
+        idx = np.ascontiguousarray(idx, np.int64)
+
+        def body(s):
+            out = np.empty((len(idx), 3), np.float64)
+            check(lib.gmpu_surface_copy_normals_at(s, ffi.from_buffer("int64_t[]", idx), len(idx), double_ptr(out)),
+                  "gmpu_surface_copy_normals_at")
+            return out
+
+        return self._read(body)
+
 
 def reconstruct(points: Union[ArrayLike, Points, PathLike], *, normals: Optional[ArrayLike] = None,
                 error: Optional[float] = None, max_depth: Optional[int] = None,

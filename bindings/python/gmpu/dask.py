@@ -472,7 +472,7 @@ def _tile_surface(source: Any, plan: TilePlan, tile: int, params: Dict[str, Any]
         blocks = g.block_of_key(keys)
         values = _evaluate_grid(s, g, blocks)
         lap("evaluate")
-        normals = s.normals[shared]
+        normals = s.normals_at(shared)
     finally:
         s.close()
     if reverse:

@@ -835,6 +835,20 @@ impl Surface {
         Ok(out)
     }
 
+    /// The oriented unit normals of the input points `indices` only, as [`normals`](Self::normals)
+    /// gives them, without an array of every point's normal. Needs [`orient`](Self::orient);
+    /// an index not below the point count is [`Status::InvalidArgument`].
+    pub fn normals_at(&self, indices: &[usize]) -> Result<Vec<[f64; 3]>> {
+        // An index beyond i64 is out of range for any surface: -1 says so to the library.
+        let idx: Vec<i64> = indices.iter().map(|&i| i64::try_from(i).unwrap_or(-1)).collect();
+        let mut out = vec![[0.0; 3]; idx.len()];
+        // SAFETY: const call; idx holds idx.len() indices and out as many triples.
+        check(unsafe {
+            sys::gmpu_surface_copy_normals_at(self.raw.as_ptr(), idx.as_ptr(), idx.len(), out.as_mut_ptr().cast())
+        })?;
+        Ok(out)
+    }
+
     /// Extracts the zero set of f as a closed, edge-manifold, outward-wound triangle mesh.
     /// Needs [`orient`](Self::orient); uses [`Param::Resolution`] and [`Param::Level`].
     pub fn polygonize(&mut self) -> Result<Mesh> {

@@ -73,9 +73,9 @@ macro_rules! c_functions {
 
 /// `#define`d integer constants of the header.
 pub const GMPU_VERSION_MAJOR: u32 = 0;
-pub const GMPU_VERSION_MINOR: u32 = 4;
+pub const GMPU_VERSION_MINOR: u32 = 5;
 pub const GMPU_VERSION_PATCH: u32 = 0;
-pub const GMPU_VERSION_NUMBER: u32 = 400;
+pub const GMPU_VERSION_NUMBER: u32 = 500;
 pub const GMPU_ABI_VERSION: u32 = 1;
 pub const DEFINES: &[(&str, u32)] = &[
     ("GMPU_VERSION_MAJOR", GMPU_VERSION_MAJOR),
@@ -230,6 +230,8 @@ c_functions! {
     pub fn gmpu_surface_evaluate(surface: *const gmpu_surface, xyz: *const f64, count: usize, values: *mut f64,
         gradients: *mut f64) -> gmpu_status;
     pub fn gmpu_surface_copy_normals(surface: *const gmpu_surface, out: *mut f64, count: usize) -> gmpu_status;
+    pub fn gmpu_surface_copy_normals_at(surface: *const gmpu_surface, indices: *const i64, count: usize,
+        out: *mut f64) -> gmpu_status;
     pub fn gmpu_surface_polygonize(surface: *mut gmpu_surface, out: *mut *mut gmpu_mesh) -> gmpu_status;
 
     pub fn gmpu_mesh_create(vertices: *const f64, vertex_count: usize, triangles: *const u32,

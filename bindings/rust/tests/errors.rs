@@ -71,8 +71,15 @@ fn stages_in_the_wrong_order() {
     s.fit().unwrap();
     expect_err(s.evaluate(&[[0.0; 3]]), Status::WrongOrder, "orient");
     expect_err(s.polygonize(), Status::WrongOrder, "orient");
+    expect_err(s.normals_at(&[0]), Status::WrongOrder, "gmpu_surface_copy_normals_at");
     s.orient().unwrap();
     assert!(s.evaluate(&[[0.0; 3]]).unwrap()[0] > 0.0);
+    // The normals of chosen points are rows of every point's; a bad index is named.
+    let all = s.normals().unwrap();
+    assert_eq!(s.normals_at(&[499, 0, 7, 7]).unwrap(), vec![all[499], all[0], all[7], all[7]]);
+    assert!(s.normals_at(&[]).unwrap().is_empty());
+    expect_err(s.normals_at(&[1, 500]), Status::InvalidArgument, "indices[1] = 500 is not a point");
+    expect_err(s.normals_at(&[usize::MAX]), Status::InvalidArgument, "indices[0] = -1");
     // Changing a fit parameter discards the fit (and so the orientation).
     s.set_param(Param::Error, 0.004).unwrap();
     expect_err(s.evaluate(&[[0.0; 3]]), Status::WrongOrder, "");
