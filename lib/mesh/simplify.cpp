@@ -224,12 +224,44 @@ Mesh simplify_mesh(const Mesh &mesh, size_t target_triangles, double target_erro
         std::vector<float> positions(base.vertices.begin(), base.vertices.end());
         // Large meshes: most of the reduction patch by patch, each with its own retries,
         // then one pass over the whole (smaller) mesh to reach the target across the seams.
+        bool chunked = false;
         if (current.size() / 3 > 2 * kChunkTriangles && target_triangles * 2 < current.size() / 3) {
-            const ChunkedDecimation chunks =
-                decimate_in_chunks(positions, current, target_triangles, budget, kChunkTriangles, workers, progress);
-            if (chunks.kept) current = chunks.triangles, spent = chunks.spent;
+            // One round over the whole mesh first. When it keeps the topology, or stops at the
+            // error bound short of the count (where chunks, each held to its share of the
+            // count, would stop shorter still), the rounds go on over the whole mesh; when it
+            // reaches the count but breaks the topology, the chunks redo it, each retrying
+            // alone.
+            const double scale = double(meshopt_simplifyScale(positions.data(), base.vertex_count(), 3 * sizeof(float)));
+            std::vector<uint32_t> trial;
+            float round_error = 0.0f;
+            const size_t got = scale > 0 ? collapse_round(current, positions, std::vector<char>(base.vertex_count(), 0),
+                                                          target_triangles, budget / scale, trial, round_error)
+                                         : current.size() / 3;
+            Mesh probe;  // mesh_topology reads the vertex count, not the positions
+            probe.vertices.assign(base.vertices.size(), 0.0);
+            probe.triangles = current;
+            const MeshTopology before = mesh_topology(probe);
+            probe.triangles = trial;
+            if (keeps_topology(before, mesh_topology(probe))) {
+                current.swap(trial);
+                spent = double(round_error) * scale;
+            } else if (got <= target_triangles) {
+                // Half the error bound: the other half is for the pass over the whole mesh,
+                // which collapses the seams the chunks had to keep.
+                const ChunkedDecimation chunks = decimate_in_chunks(positions, current, target_triangles, 0.5 * budget,
+                                                                    kChunkTriangles, workers, progress);
+                if (chunks.kept) current = chunks.triangles, spent = chunks.spent, chunked = true;
+            }
         }
         spent += decimate_patch(positions, current, target_triangles, budget - spent).spent;
+        // Each chunk spends the error bound on its own share of the count, where the whole
+        // mesh collapses wherever it is cheapest: the chunks may use up the bound short of
+        // the count the whole mesh reaches. Then the whole mesh, from the start.
+        if (chunked && target_triangles > 0 && current.size() / 3 > target_triangles) {
+            std::vector<uint32_t> whole = base.triangles;
+            const double whole_spent = decimate_patch(positions, whole, target_triangles, budget).spent;
+            if (whole.size() < current.size()) current.swap(whole), spent = whole_spent;
+        }
     }
     Mesh out = compacted(base, current);
     if (!keep_normals || out.normals.size() != out.vertices.size()) recompute_normals(out);
