@@ -39,7 +39,7 @@ void split(std::vector<uint32_t> &order, size_t begin, size_t end, const std::ve
 
 ChunkedDecimation decimate_in_chunks(const std::vector<float> &positions, const std::vector<uint32_t> &triangles,
                                      size_t target_triangles, double budget, size_t chunk_triangles,
-                                     Workers *workers, Progress *progress) {
+                                     Workers *workers, Progress *progress, const std::vector<uint32_t> *guide) {
     ChunkedDecimation result;
     const size_t count = triangles.size() / 3, n = positions.size() / 3;
     if (count == 0) return result;
@@ -69,6 +69,12 @@ ChunkedDecimation decimate_in_chunks(const std::vector<float> &positions, const 
             else if (first_chunk[v] != result.chunk[t]) seam[v] = 1;
         }
 
+    // Each chunk's share of the target: from the guide's triangles in the chunk (by their
+    // first vertex's chunk) when there is one, else from the chunk's share of the input.
+    std::vector<double> guided(chunks, 0.0);
+    if (guide && !guide->empty())
+        for (size_t t = 0; t < guide->size(); t += 3) guided[first_chunk[(*guide)[t]]] += 1.0;
+
     auto decimate_chunk = [&](size_t c) {
         const size_t begin = c == 0 ? 0 : ends[c - 1], end = ends[c];
         // The chunk as a mesh of its own: its vertices renumbered, so meshopt's work and
@@ -86,7 +92,8 @@ ChunkedDecimation decimate_in_chunks(const std::vector<float> &positions, const 
         std::vector<uint32_t> local(global.size());
         for (size_t i = 0; i < global.size(); ++i)
             local[i] = uint32_t(std::lower_bound(ids.begin(), ids.end(), global[i]) - ids.begin());
-        const double share = double(end - begin) / double(count);
+        const double share = guide && !guide->empty() ? guided[c] / double(guide->size() / 3)
+                                                      : double(end - begin) / double(count);
         const size_t target = target_triangles == 0 ? 0 : size_t(std::ceil(kChunkSlack * share * double(target_triangles)));
         // Where the cut passed, the chunk's edges have one triangle: a border, which the
         // collapses leave in place, so the neighbouring chunk finds the same vertices. Their

@@ -28,8 +28,11 @@ struct ChunkedDecimation {
 // chunk, each chunk towards its share of `target_triangles` (a little more: the pass over
 // the whole mesh chooses the last collapses by error across chunks) within `budget`
 // (absolute). On `workers` when given (with `progress`), else on the calling thread.
+// `guide` (may be null): the same mesh decimated towards the target without regard to the
+// topology; each chunk's share of the target is then the guide's share in the chunk, so the
+// triangles go where the error-ordered collapses over the whole mesh left them.
 ChunkedDecimation decimate_in_chunks(const std::vector<float> &positions, const std::vector<uint32_t> &triangles,
                                      size_t target_triangles, double budget, size_t chunk_triangles,
-                                     Workers *workers, Progress *progress);
+                                     Workers *workers, Progress *progress, const std::vector<uint32_t> *guide = nullptr);
 
 }  // namespace gmpu
