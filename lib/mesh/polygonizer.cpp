@@ -300,7 +300,7 @@ Mesh polygonize(const SurfaceField &field, int resolution, const Params &params,
     remove_unsupported_components(mesh, votes, kMinVotes, cleanup_progress);
     if (clean) sharpen_features(mesh, kSharpenReach * h / points.normalisation().scale, sharpen_progress);
     // A grid the caller chose keeps all its triangles.
-    if (params.resolution == 0) cap_mesh_size(mesh, points.size(), kCapErrorShare * params.error, cap_progress);
+    if (params.resolution == 0) cap_mesh_size(mesh, points.size(), kCapErrorShare * params.error, workers, cap_progress);
     return mesh;  // the caller makes the final report, once the temporaries are freed
 }
 

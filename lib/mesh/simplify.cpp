@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "mesh/chunked_decimation.hpp"
 #include "mesh/mesh_topology.hpp"
 
 namespace gmpu {
@@ -142,37 +143,42 @@ size_t collapse_round(const std::vector<uint32_t> &triangles, const std::vector<
 
 }  // namespace
 
-Mesh simplify_mesh(const Mesh &mesh, size_t target_triangles, double target_error, double *achieved_error,
-                   bool keep_normals) {
-    if (achieved_error) *achieved_error = 0.0;
-    if (mesh.triangles.empty()) return Mesh();  // nothing to weld or collapse (and no vertex in use)
-    Mesh base = welded(mesh);
-    const MeshTopology before = mesh_topology(base);
-    std::vector<float> positions(base.vertices.begin(), base.vertices.end());
-    const size_t n = base.vertex_count();
-    // meshopt measures error relative to its own scale (the largest extent); ours is the
-    // diagonal.
-    const double diagonal = bbox_diagonal(base.vertices);
-    const double scale = n ? double(meshopt_simplifyScale(positions.data(), n, 3 * sizeof(float))) : 0.0;
-    const double to_meshopt = scale > 0 ? diagonal / scale : 0.0;
+bool keeps_topology(const MeshTopology &before, const MeshTopology &after) {
+    return after.same_as(before) && after.nonmanifold_edges <= before.nonmanifold_edges &&
+           after.nonmanifold_vertices <= before.nonmanifold_vertices &&
+           after.degenerate_triangles <= before.degenerate_triangles &&
+           after.duplicate_triangles <= before.duplicate_triangles;
+}
 
-    std::vector<uint32_t> current = base.triangles, next, culprits;
-    std::vector<char> locked(n, 0);
-    double spent = 0.0;  // error bound used so far (rounds add up: triangle inequality)
+PatchDecimation decimate_patch(const std::vector<float> &positions, std::vector<uint32_t> &triangles,
+                               size_t target_triangles, double budget, const std::vector<char> *fixed) {
+    PatchDecimation result;
+    const size_t n = positions.size() / 3;
+    if (triangles.empty() || n == 0) return result;
+    // meshopt measures error relative to its own scale (the patch's largest extent).
+    const double scale = double(meshopt_simplifyScale(positions.data(), n, 3 * sizeof(float)));
+    if (!(scale > 0.0) || !std::isfinite(scale)) return result;
+    Mesh probe;  // mesh_topology reads the vertex count, not the positions
+    probe.vertices.assign(3 * n, 0.0);
+    probe.triangles = triangles;
+    const MeshTopology before = mesh_topology(probe);
+
+    std::vector<uint32_t> next, culprits;
+    std::vector<char> locked = fixed && fixed->size() == n ? *fixed : std::vector<char>(n, 0);
     int failures = 0;
     size_t ask = target_triangles;  // of this round: more than the target after a failure
-    Mesh probe;
-    probe.vertices = base.vertices;
-    while (current.size() / 3 > target_triangles && failures <= kRetries && spent <= target_error) {
+    while (triangles.size() / 3 > target_triangles && failures <= kRetries && result.spent <= budget) {
         float round_error = 0.0f;
-        const size_t got = collapse_round(current, positions, locked, ask,
-                                          (target_error - spent) * to_meshopt, next, round_error);
-        if (3 * got >= current.size()) break;  // the error bound (or the locks) allow no collapse
+        ++result.rounds;
+        result.work += triangles.size() / 3;
+        const size_t got = collapse_round(triangles, positions, locked, ask, (budget - result.spent) / scale, next,
+                                          round_error);
+        if (3 * got >= triangles.size()) break;  // the error bound (or the locks) allow no collapse
         probe.triangles = next;
         culprits.clear();
-        if (mesh_topology(probe, &culprits).same_as(before)) {
-            current.swap(next);
-            spent += to_meshopt > 0 ? double(round_error) / to_meshopt : 0.0;
+        if (keeps_topology(before, mesh_topology(probe, &culprits))) {
+            triangles.swap(next);
+            result.spent += double(round_error) * scale;
             failures = 0;
             ask = target_triangles;
             continue;
@@ -181,10 +187,11 @@ Mesh simplify_mesh(const Mesh &mesh, size_t target_triangles, double target_erro
         // condition). Lock where it went wrong, with the neighbours that could collapse
         // there, and redo the round from the last good mesh.
         ++failures;
+        ++result.retries;
         if (culprits.empty()) {
             // A change with no local sign (a handle closed cleanly): ask for half the
             // reduction, fewer collapses and fewer chances of the bad one.
-            const size_t have = current.size() / 3;
+            const size_t have = triangles.size() / 3;
             ask = have - (have - ask) / 2;
             if (ask >= have) break;
             continue;
@@ -193,7 +200,7 @@ Mesh simplify_mesh(const Mesh &mesh, size_t target_triangles, double target_erro
         for (uint32_t v : culprits) bad[v] = 1;
         for (int ring = 0; ring < kLockRings; ++ring) {
             std::vector<char> grown = bad;
-            for (const std::vector<uint32_t> *tris : {&current, &next})
+            for (const std::vector<uint32_t> *tris : {&triangles, &next})
                 for (size_t t = 0; t < tris->size(); t += 3)
                     if (bad[(*tris)[t]] || bad[(*tris)[t + 1]] || bad[(*tris)[t + 2]])
                         for (int k = 0; k < 3; ++k) grown[(*tris)[t + k]] = 1;
@@ -201,9 +208,64 @@ Mesh simplify_mesh(const Mesh &mesh, size_t target_triangles, double target_erro
         }
         for (size_t v = 0; v < n; ++v) locked[v] = locked[v] || bad[v];
     }
+    return result;
+}
+
+Mesh simplify_mesh(const Mesh &mesh, size_t target_triangles, double target_error, double *achieved_error,
+                   bool keep_normals, Workers *workers, Progress *progress) {
+    if (achieved_error) *achieved_error = 0.0;
+    if (mesh.triangles.empty()) return Mesh();  // nothing to weld or collapse (and no vertex in use)
+    Mesh base = welded(mesh);
+    const double diagonal = bbox_diagonal(base.vertices);
+    std::vector<uint32_t> current = base.triangles;
+    double spent = 0.0;  // absolute error bound used so far (passes add up: triangle inequality)
+    if (diagonal > 0.0) {
+        const double budget = target_error * diagonal;
+        std::vector<float> positions(base.vertices.begin(), base.vertices.end());
+        // Large meshes: most of the reduction patch by patch, each with its own retries,
+        // then one pass over the whole (smaller) mesh to reach the target across the seams.
+        bool chunked = false;
+        if (current.size() / 3 > 2 * kChunkTriangles && target_triangles * 2 < current.size() / 3) {
+            // One round over the whole mesh first. When it keeps the topology, or stops at the
+            // error bound short of the count (where chunks, each held to its share of the
+            // count, would stop shorter still), the rounds go on over the whole mesh; when it
+            // reaches the count but breaks the topology, the chunks redo it, each retrying
+            // alone.
+            const double scale = double(meshopt_simplifyScale(positions.data(), base.vertex_count(), 3 * sizeof(float)));
+            std::vector<uint32_t> trial;
+            float round_error = 0.0f;
+            const size_t got = scale > 0 ? collapse_round(current, positions, std::vector<char>(base.vertex_count(), 0),
+                                                          target_triangles, budget / scale, trial, round_error)
+                                         : current.size() / 3;
+            Mesh probe;  // mesh_topology reads the vertex count, not the positions
+            probe.vertices.assign(base.vertices.size(), 0.0);
+            probe.triangles = current;
+            const MeshTopology before = mesh_topology(probe);
+            probe.triangles = trial;
+            if (keeps_topology(before, mesh_topology(probe))) {
+                current.swap(trial);
+                spent = double(round_error) * scale;
+            } else if (got <= target_triangles) {
+                // Half the error bound: the other half is for the pass over the whole mesh,
+                // which collapses the seams the chunks had to keep.
+                const ChunkedDecimation chunks = decimate_in_chunks(positions, current, target_triangles, 0.5 * budget,
+                                                                    kChunkTriangles, workers, progress, &trial);
+                if (chunks.kept) current = chunks.triangles, spent = chunks.spent, chunked = true;
+            }
+        }
+        spent += decimate_patch(positions, current, target_triangles, budget - spent).spent;
+        // Each chunk spends the error bound on its own share of the count, where the whole
+        // mesh collapses wherever it is cheapest: the chunks may use up the bound short of
+        // the count the whole mesh reaches. Then the whole mesh, from the start.
+        if (chunked && target_triangles > 0 && current.size() / 3 > target_triangles) {
+            std::vector<uint32_t> whole = base.triangles;
+            const double whole_spent = decimate_patch(positions, whole, target_triangles, budget).spent;
+            if (whole.size() < current.size()) current.swap(whole), spent = whole_spent;
+        }
+    }
     Mesh out = compacted(base, current);
     if (!keep_normals || out.normals.size() != out.vertices.size()) recompute_normals(out);
-    if (achieved_error) *achieved_error = spent;
+    if (achieved_error) *achieved_error = diagonal > 0.0 ? spent / diagonal : 0.0;
     return out;
 }
 

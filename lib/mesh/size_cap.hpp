@@ -7,6 +7,7 @@
 
 #include <cstddef>
 
+#include "core/parallel.hpp"
 #include "core/progress.hpp"
 #include "mesh/mesh.hpp"
 
@@ -19,7 +20,8 @@ constexpr double kTrianglesPerPoint = 2.0;
 // kTrianglesPerPoint × `points` triangles: towards a little under that count, stopping
 // where the next collapse would move the surface by more than `max_error` (a fraction of
 // the bounding-box diagonal). Watertight, edge-manifold, components and genus kept; the
-// remaining vertices keep their positions and normals.
-void cap_mesh_size(Mesh &mesh, size_t points, double max_error, Progress &progress);
+// remaining vertices keep their positions and normals. Large meshes are decimated chunk by
+// chunk on `workers` (simplify.hpp).
+void cap_mesh_size(Mesh &mesh, size_t points, double max_error, Workers &workers, Progress &progress);
 
 }  // namespace gmpu

@@ -1,0 +1,116 @@
+// Decimation of large meshes chunk by chunk (mesh/chunked_decimation.hpp): the vertices two
+// chunks share stay, so the chunks fit back together into the same closed surface, and a
+// chunk whose collapses break the topology is redone alone while the others keep their
+// single round.
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include "mesh/chunked_decimation.hpp"
+#include "mesh/mesh_topology.hpp"
+
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+extern "C" {
+#include <cmocka.h>
+}
+
+using namespace gmpu;
+
+namespace {
+
+// Appends a closed torus (outward-wound, `around` × `tube` quads) centred at x = `cx`.
+void add_torus(std::vector<float> &positions, std::vector<uint32_t> &triangles, float cx, float major, float minor,
+               uint32_t around, uint32_t tube) {
+    const uint32_t first = uint32_t(positions.size() / 3);
+    for (uint32_t i = 0; i < around; ++i)
+        for (uint32_t j = 0; j < tube; ++j) {
+            const double u = 2 * M_PI * i / around, v = 2 * M_PI * j / tube;
+            positions.push_back(float(cx + (major + minor * std::cos(v)) * std::cos(u)));
+            positions.push_back(float((major + minor * std::cos(v)) * std::sin(u)));
+            positions.push_back(float(minor * std::sin(v)));
+        }
+    auto at = [&](uint32_t i, uint32_t j) { return first + (i % around) * tube + j % tube; };
+    for (uint32_t i = 0; i < around; ++i)
+        for (uint32_t j = 0; j < tube; ++j) {
+            const uint32_t a = at(i, j), b = at(i + 1, j), c = at(i + 1, j + 1), d = at(i, j + 1);
+            triangles.insert(triangles.end(), {a, b, c, a, c, d});
+        }
+}
+
+MeshTopology topology(size_t vertices, const std::vector<uint32_t> &triangles) {
+    Mesh m;
+    m.vertices.assign(3 * vertices, 0.0);
+    m.triangles = triangles;
+    return mesh_topology(m);
+}
+
+void chunk_borders_stay(void **) {
+    std::vector<float> positions;
+    std::vector<uint32_t> triangles;
+    add_torus(positions, triangles, 0.0f, 1.0f, 0.4f, 200, 100);  // 40 000 triangles
+    const size_t n = positions.size() / 3, count = triangles.size() / 3;
+    assert_true(topology(n, triangles).closed_manifold());
+    const ChunkedDecimation d = decimate_in_chunks(positions, triangles, count / 10, 1.0, 8192, nullptr, nullptr);
+    assert_int_equal(d.chunks.size(), 8);
+    assert_true(d.kept);
+    // The seams and the ring beside them stay whole: a third, not the tenth asked for.
+    assert_true(d.triangles.size() / 3 < count / 3);
+    // Every vertex the triangles of two chunks share is still in the result.
+    std::vector<int64_t> first_chunk(n, -1);
+    std::vector<char> shared(n, 0), used(n, 0);
+    for (size_t t = 0; t < count; ++t)
+        for (int k = 0; k < 3; ++k) {
+            const uint32_t v = triangles[3 * t + k];
+            if (first_chunk[v] < 0) first_chunk[v] = d.chunk[t];
+            else if (first_chunk[v] != d.chunk[t]) shared[v] = 1;
+        }
+    for (uint32_t v : d.triangles) used[v] = 1;
+    size_t shared_count = 0;
+    for (size_t v = 0; v < n; ++v) {
+        shared_count += shared[v];
+        if (shared[v]) assert_true(used[v]);
+    }
+    assert_true(shared_count > 0);
+    const MeshTopology after = topology(n, d.triangles);
+    assert_true(after.closed_manifold());
+    assert_int_equal(after.components, 1);
+    assert_int_equal(after.euler_characteristic, 0);  // genus 1
+}
+
+void failing_chunk_alone_is_retried(void **) {
+    // A fat torus that decimates in one round, and far off a thin one whose tube, cut down
+    // to a few triangles, pinches: its rounds break the topology and are redone.
+    std::vector<float> positions;
+    std::vector<uint32_t> triangles;
+    add_torus(positions, triangles, 0.0f, 1.0f, 0.4f, 200, 100);
+    const size_t fat = triangles.size() / 3;
+    add_torus(positions, triangles, 10.0f, 1.0f, 0.01f, 400, 8);
+    const size_t n = positions.size() / 3, count = triangles.size() / 3;
+    const ChunkedDecimation d = decimate_in_chunks(positions, triangles, count / 50, 100.0, 4096, nullptr, nullptr);
+    assert_true(d.kept);
+    std::vector<char> has_thin(d.chunks.size(), 0);
+    for (size_t t = fat; t < count; ++t) has_thin[d.chunk[t]] = 1;
+    size_t retried = 0, fat_only = 0;
+    for (size_t c = 0; c < d.chunks.size(); ++c) {
+        if (d.chunks[c].retries > 0) ++retried;
+        fat_only += !has_thin[c];
+        // A chunk of the fat torus alone is never redone for the thin one's failures.
+        if (!has_thin[c]) assert_int_equal(d.chunks[c].retries, 0);
+    }
+    assert_true(retried > 0);
+    assert_true(fat_only >= 8);  // most of the fat torus was spared the thin one's retries
+    const MeshTopology after = topology(n, d.triangles);
+    assert_true(after.closed_manifold());
+    assert_int_equal(after.components, 2);
+    assert_int_equal(after.euler_characteristic, 0);
+}
+
+}  // namespace
+
+int main() {
+    const struct CMUnitTest tests[] = {cmocka_unit_test(chunk_borders_stay), cmocka_unit_test(failing_chunk_alone_is_retried)};
+    return cmocka_run_group_tests(tests, nullptr, nullptr);
+}
