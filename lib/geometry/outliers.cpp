@@ -26,9 +26,6 @@ struct DoubleCloud {
 using DoubleTree = nanoflann::KDTreeSingleIndexAdaptor<nanoflann::L2_Simple_Adaptor<double, DoubleCloud>,
                                                        DoubleCloud, 3, uint32_t>;
 
-// Fewer points scan on one thread: handing out the work would cost more.
-constexpr size_t kParallelScanPoints = 1u << 15;
-
 // Whether, on some axis, the bounding box is over kBulkFactor times as wide as the range
 // between the kBulkQuantile and 1 - kBulkQuantile quantiles of a sample: outliers that
 // would set the scale widen the box so. Sets `finite` to whether every coordinate is within
@@ -89,11 +86,8 @@ OutlierScan find_outliers(const T *xyz, size_t count, size_t stride, bool only_i
     DoubleTree tree(3, cloud,
                     nanoflann::KDTreeSingleIndexAdaptorParams(16, nanoflann::KDTreeSingleIndexAdaptorFlags::SkipInitialBuildIndex));
     std::vector<std::unique_ptr<nanoflann::PooledAllocator>> subtrees;  // the nodes of a parallel build
-    const bool parallel = workers && workers->threads() > 1 && count >= kParallelScanPoints;
-    if (parallel)
-        build_kdtree_in_parallel(tree, subtrees, *workers);
-    else
-        tree.buildIndex();
+    // The neighbour test below shares its work among the threads when the build did.
+    const bool parallel = build_kdtree(tree, subtrees, workers);
 
     // Spacing: the median k-th neighbour distance (the point itself is the 0th) over a sample.
     constexpr size_t kSamples = 1024;

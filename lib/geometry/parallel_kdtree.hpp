@@ -160,4 +160,21 @@ void build_kdtree_in_parallel(Tree &tree, std::vector<std::unique_ptr<nanoflann:
     tree.root_bbox = tasks[0].bbox;
 }
 
+// Fewer points build on one thread: handing out the work would cost more.
+constexpr size_t kParallelKdtreePoints = 1u << 15;
+
+// Builds `tree` on `workers` when they have several threads and it has enough points, else
+// with its own buildIndex(); the same tree either way. `pools` as for build_kdtree_in_parallel.
+// Returns whether it shared the work, so that the tree's users can share theirs alike.
+template <class Tree>
+bool build_kdtree(Tree &tree, std::vector<std::unique_ptr<nanoflann::PooledAllocator>> &pools, Workers *workers) {
+    const bool parallel = workers && workers->threads() > 1 &&
+                          size_t(tree.dataset.kdtree_get_point_count()) >= kParallelKdtreePoints;
+    if (parallel)
+        build_kdtree_in_parallel(tree, pools, *workers);
+    else
+        tree.buildIndex();
+    return parallel;
+}
+
 }  // namespace gmpu

@@ -89,10 +89,7 @@ struct PointSet::Index {
         : adaptor{pts.data(), ids ? ids->size() : pts.size() / 3, ids ? ids->data() : nullptr},
           tree(3, adaptor,
                nanoflann::KDTreeSingleIndexAdaptorParams(16, nanoflann::KDTreeSingleIndexAdaptorFlags::SkipInitialBuildIndex)) {
-        if (workers && workers->threads() > 1 && adaptor.count >= kParallelBuildPoints)
-            build_kdtree_in_parallel(tree, subtrees, *workers);
-        else
-            tree.buildIndex();
+        build_kdtree(tree, subtrees, workers);
     }
 };
 

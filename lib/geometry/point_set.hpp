@@ -61,8 +61,6 @@ public:
     void coarse_within(const Eigen::Vector3d &centre, double radius, std::vector<uint32_t> &out) const;
     double coarse_ratio() const { return coarse_ratio_; }
     static constexpr size_t kCoarsePoints = 1u << 16;
-    // Fewer points build their kd-tree on one thread: handing out the work would cost more.
-    static constexpr size_t kParallelBuildPoints = 1u << 15;
 
     // Number of points within `radius`, stopping early once `enough` are found.
     size_t count_within(const Eigen::Vector3d &centre, double radius, size_t enough) const;
