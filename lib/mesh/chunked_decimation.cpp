@@ -39,7 +39,8 @@ void split(std::vector<uint32_t> &order, size_t begin, size_t end, const std::ve
 
 ChunkedDecimation decimate_in_chunks(const std::vector<float> &positions, const std::vector<uint32_t> &triangles,
                                      size_t target_triangles, double budget, size_t chunk_triangles,
-                                     Workers *workers, Progress *progress, const std::vector<uint32_t> *guide) {
+                                     Workers *workers, Progress *progress, const std::vector<uint32_t> *guide,
+                                     const MeshTopology *topology) {
     ChunkedDecimation result;
     const size_t count = triangles.size() / 3, n = positions.size() / 3;
     if (count == 0) return result;
@@ -120,10 +121,12 @@ ChunkedDecimation decimate_in_chunks(const std::vector<float> &positions, const 
     // prove the whole's (two chunks could trade a component): one check of the result.
     Mesh probe;  // mesh_topology reads the vertex count, not the positions
     probe.vertices.assign(3 * n, 0.0);
-    probe.triangles = triangles;
-    const MeshTopology before = mesh_topology(probe);
-    probe.triangles = result.triangles;
-    result.kept = keeps_topology(before, mesh_topology(probe));
+    auto topology_of = [&](const std::vector<uint32_t> &tris) {
+        probe.triangles = tris;
+        return mesh_topology(probe);
+    };
+    const MeshTopology before = topology ? *topology : topology_of(triangles);
+    result.kept = keeps_topology(before, topology_of(result.triangles));
     return result;
 }
 

@@ -12,6 +12,7 @@
 
 #include "core/parallel.hpp"
 #include "core/progress.hpp"
+#include "mesh/mesh_topology.hpp"
 #include "mesh/simplify.hpp"
 
 namespace gmpu {
@@ -31,8 +32,10 @@ struct ChunkedDecimation {
 // `guide` (may be null): the same mesh decimated towards the target without regard to the
 // topology; each chunk's share of the target is then the guide's share in the chunk, so the
 // triangles go where the error-ordered collapses over the whole mesh left them.
+// `topology` (may be null): the input's mesh_topology, when the caller has it already.
 ChunkedDecimation decimate_in_chunks(const std::vector<float> &positions, const std::vector<uint32_t> &triangles,
                                      size_t target_triangles, double budget, size_t chunk_triangles,
-                                     Workers *workers, Progress *progress, const std::vector<uint32_t> *guide = nullptr);
+                                     Workers *workers, Progress *progress, const std::vector<uint32_t> *guide = nullptr,
+                                     const MeshTopology *topology = nullptr);
 
 }  // namespace gmpu

@@ -249,7 +249,7 @@ Mesh simplify_mesh(const Mesh &mesh, size_t target_triangles, double target_erro
                 // Half the error bound: the other half is for the pass over the whole mesh,
                 // which collapses the seams the chunks had to keep.
                 const ChunkedDecimation chunks = decimate_in_chunks(positions, current, target_triangles, 0.5 * budget,
-                                                                    kChunkTriangles, workers, progress, &trial);
+                                                                    kChunkTriangles, workers, progress, &trial, &before);
                 if (chunks.kept) current = chunks.triangles, spent = chunks.spent, chunked = true;
             }
         }
