@@ -100,6 +100,13 @@ void push_params(const gmpu::Params &p, gmpu::api::SurfaceParts &parts) {
         parts.set_param(gmpu_param(key), gmpu::api::get_param(p, gmpu_param(key)));
 }
 
+// The kept point whose normal input point i takes, `before` being the number of outliers
+// before i: kept points are numbered without them, and an outlier takes the normal of the
+// kept point nearest to it.
+size_t normal_source(const gmpu_surface &s, size_t i, size_t before) {
+    return before < s.outliers.size() && s.outliers[before] == i ? s.outlier_nearest[before] : i - before;
+}
+
 template <class T>
 gmpu_status set_points(gmpu_surface *s, const T *xyz, size_t count, size_t stride) {
     return guarded(s ? &s->last_error : nullptr, [&] {
@@ -332,14 +339,10 @@ GMPU_API gmpu_status gmpu_surface_copy_normals(const gmpu_surface *s, double *ou
             throw Error(GMPU_ERROR_INVALID_ARGUMENT, "count " + std::to_string(count) + " differs from the " +
                                                          std::to_string(s->input_count) + " points");
         if (s->parts) return s->parts->copy_normals(out, count);
-        // An outlier takes the normal of the kept point nearest to it.
-        size_t next_outlier = 0, kept = 0;
+        size_t before = 0;  // outliers before point i
         for (size_t i = 0; i < count; ++i) {
-            size_t from;
-            if (next_outlier < s->outliers.size() && s->outliers[next_outlier] == i)
-                from = s->outlier_nearest[next_outlier++];
-            else
-                from = kept++;
+            while (before < s->outliers.size() && s->outliers[before] < i) ++before;
+            const size_t from = normal_source(*s, i, before);
             for (int d = 0; d < 3; ++d) out[3 * i + d] = double(s->measures.normals[3 * from + d]);
         }
     });
@@ -363,12 +366,8 @@ GMPU_API gmpu_status gmpu_surface_copy_normals_at(const gmpu_surface *s, const i
         if (s->parts) return s->parts->copy_normals_at(indices, count, out);
         for (size_t j = 0; j < count; ++j) {
             const auto i = uint32_t(indices[j]);
-            // Kept points are numbered without the outliers before them; an outlier takes
-            // the normal of the kept point nearest to it (as copy_normals).
             const auto before = std::lower_bound(s->outliers.begin(), s->outliers.end(), i);
-            const size_t from = before != s->outliers.end() && *before == i
-                                    ? s->outlier_nearest[size_t(before - s->outliers.begin())]
-                                    : i - size_t(before - s->outliers.begin());
+            const size_t from = normal_source(*s, i, size_t(before - s->outliers.begin()));
             for (int d = 0; d < 3; ++d) out[3 * j + d] = double(s->measures.normals[3 * from + d]);
         }
     });
