@@ -143,8 +143,8 @@ typedef enum gmpu_param {
      * than 7 % of its size (so the coarse surface keeps the topology of the full one);
      * 0 uses every level. Default 0, range 0..16. */
     GMPU_PARAM_LEVEL = 7,
-    /* Worker threads for fit, orient and polygonize; 0 uses every core. Default 0,
-     * range 0..1024. */
+    /* Worker threads for set_points (kd-tree build, outlier scan), fit, orient and
+     * polygonize; 0 uses every core. Default 0, range 0..1024. */
     GMPU_PARAM_THREADS = 8,
     /* Resource cap: fit fails with GMPU_ERROR_LIMIT_EXCEEDED instead of creating more
      * octree cells than this (the default is about 4 GB). Default 2e7, range 1..1e9. */

@@ -289,7 +289,8 @@ key_enum! {
         Resolution = sys::GMPU_PARAM_RESOLUTION,
         /// Level of detail for evaluate and polygonize; 0 uses every level.
         Level = sys::GMPU_PARAM_LEVEL,
-        /// Worker threads for fit, orient and polygonize; 0 uses every core.
+        /// Worker threads for set_points (kd-tree build, outlier scan), fit, orient and polygonize;
+        /// 0 uses every core.
         Threads = sys::GMPU_PARAM_THREADS,
         /// Fit fails with [`Status::LimitExceeded`] instead of making more cells than this.
         MaxCells = sys::GMPU_PARAM_MAX_CELLS,
