@@ -1,5 +1,6 @@
 #include "implicit/winding_field.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 namespace gmpu {
@@ -11,26 +12,59 @@ constexpr double kInv4Pi = 0.25 / M_PI;
 WindingField::WindingField(const Octree &tree, const PointSet &points, const std::vector<float> &normals,
                            const std::vector<float> &area, Progress *progress)
     : tree_(&tree), points_(&points), moments_(tree.cells.size()), normals_(&normals), area_(&area) {
-    // Children follow parents, so a reverse sweep could aggregate; a direct pass over each
-    // cell's contiguous point range is as simple and costs O(n · depth).
-    for (size_t c = 0; c < tree.cells.size(); ++c) {
-        if (progress) progress->poll(double(c) / double(tree.cells.size()));
+    // Children follow their parents, so a reverse sweep meets every child before its
+    // parent: a leaf sums its own points, a parent its children's sums, O(n + cells) where a
+    // pass over each cell's point range would cost O(n · depth).
+    const size_t cells = tree.cells.size();
+    std::vector<double> total(cells, 0.0);
+    std::vector<Eigen::Vector3d> weighted_sum(cells, Eigen::Vector3d::Zero());
+    for (size_t c = cells; c-- > 0;) {
+        if (progress) progress->poll(0.5 * double(cells - c) / double(cells));
         const Cell &cell = tree.cells[c];
         Moment &m = moments_[c];
-        double total = 0.0;
-        for (uint32_t k = cell.point_begin; k < cell.point_end; ++k) {
-            // The root and the coarse cells span most of the points: report within them.
-            if (progress && (k - cell.point_begin) % 8192 == 8191) progress->tick();
-            double a = double(area[tree.order[k]]);
-            m.centroid += a * points.point(tree.order[k]);
-            m.dipole += weighted(tree.order[k]);
-            total += a;
+        if (cell.is_leaf()) {
+            for (uint32_t k = cell.point_begin; k < cell.point_end; ++k) {
+                const double a = double(area[tree.order[k]]);
+                weighted_sum[c] += a * points.point(tree.order[k]);
+                m.dipole += weighted(tree.order[k]);
+                total[c] += a;
+            }
+        } else {
+            for (int o = 0; o < 8; ++o) {
+                const int32_t k = tree.child(cell, o);
+                if (k < 0) continue;
+                weighted_sum[c] += weighted_sum[size_t(k)];
+                m.dipole += moments_[size_t(k)].dipole;
+                total[c] += total[size_t(k)];
+            }
         }
-        if (total <= 0.0) continue;
-        m.centroid /= total;
-        for (uint32_t k = cell.point_begin; k < cell.point_end; ++k)
-            m.radius = std::max(m.radius, (points.point(tree.order[k]) - m.centroid).norm());
+        if (total[c] > 0.0) m.centroid = weighted_sum[c] / total[c];
     }
+    // The radius about each centroid, children first so that their balls bound the search.
+    for (size_t c = cells; c-- > 0;) {
+        if (progress) progress->poll(0.5 + 0.5 * double(cells - c) / double(cells));
+        if (total[c] > 0.0) moments_[c].radius = farthest(uint32_t(c), moments_[c].centroid, 0.0, total, progress);
+    }
+}
+
+double WindingField::farthest(uint32_t index, const Eigen::Vector3d &from, double best,
+                              const std::vector<double> &total, Progress *progress) const {
+    const Cell &c = tree_->cells[index];
+    const Moment &m = moments_[index];
+    // A cell with area holds its points within its radius of its centroid (computed
+    // already: children come later in the array than the cell asking).
+    if (total[index] > 0.0 && m.radius > 0.0 && (m.centroid - from).norm() + m.radius <= best) return best;
+    if (c.is_leaf()) {
+        if (progress) progress->tick();
+        for (uint32_t k = c.point_begin; k < c.point_end; ++k)
+            best = std::max(best, (points_->point(tree_->order[k]) - from).norm());
+        return best;
+    }
+    for (int o = 0; o < 8; ++o) {
+        const int32_t k = tree_->child(c, o);
+        if (k >= 0) best = farthest(uint32_t(k), from, best, total, progress);
+    }
+    return best;
 }
 
 double WindingField::visit(uint32_t index, const Eigen::Vector3d &q, double far_ratio2) const {

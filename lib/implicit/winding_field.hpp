@@ -20,7 +20,8 @@ public:
     WindingField() = default;
     // normals: unit outward, 3 per point; area: surface area each point stands for. Both are
     // read again by winding(), so they must outlive the field (the surface owns all three).
-    // O(n · depth): with a progress, reports between 0.95 and 1 and throws CANCELLED.
+    // O(n + cells) for the sums; each radius is a farthest-point search pruned by the
+    // children's balls. With a progress, reports and throws CANCELLED.
     WindingField(const Octree &tree, const PointSet &points, const std::vector<float> &normals,
                  const std::vector<float> &area, Progress *progress = nullptr);
 
@@ -28,6 +29,9 @@ public:
     // smaller ratio is cheaper and coarser (enough to tell 0 from 1 well away from the data).
     double winding(const Eigen::Vector3d &q, double far_ratio = 2.0) const;
     bool empty() const { return moments_.empty(); }
+    // The radius of cell `cell`'s points about their area-weighted centroid (0 for a cell
+    // without area): what decides when the cell counts as one dipole.
+    double radius(uint32_t cell) const { return moments_[cell].radius; }
 
 private:
     struct Moment {
@@ -36,6 +40,9 @@ private:
         double radius = 0.0;                               // of the points about the centroid
     };
     double visit(uint32_t cell, const Eigen::Vector3d &q, double far_ratio2) const;
+    // The largest of `best` and the distances from `from` to the points of cell `index`.
+    double farthest(uint32_t index, const Eigen::Vector3d &from, double best, const std::vector<double> &total,
+                    Progress *progress) const;
     const Octree *tree_ = nullptr;
     const PointSet *points_ = nullptr;
     std::vector<Moment> moments_;  // per cell

@@ -523,6 +523,49 @@ void winding_number_of_a_sampled_sphere(void **) {
     assert_true(WindingField().winding(Vector3d::Zero()) == 0.0);  // empty: no opinion
 }
 
+// Each cell's radius is found by a search that skips children whose ball cannot hold a
+// farther point: it must equal the largest distance of the cell's points from their
+// area-weighted centroid, counted point by point (areas uneven, some zero).
+void winding_radii_hold_their_points(void **) {
+    std::mt19937_64 rng(5);
+    std::normal_distribution<double> g(0, 1);
+    const size_t n = 6000;
+    std::vector<double> xyz;
+    for (size_t i = 0; i < n; ++i) {
+        const Vector3d u = Vector3d(g(rng), g(rng), g(rng)).normalized();
+        const Vector3d p(1.5 * u[0], u[1], 0.6 * u[2]);  // an ellipsoid: cells of many shapes
+        xyz.insert(xyz.end(), {p[0], p[1], p[2]});
+    }
+    PointSet ps = PointSet::from_array(xyz.data(), n, 0, 15);
+    std::vector<float> normals(3 * n, 0.0f), area(n);
+    for (size_t i = 0; i < n; ++i) {
+        normals[3 * i + 2] = 1.0f;
+        area[i] = i % 7 == 0 ? 0.0f : float(1e-4 * (1 + i % 5));
+    }
+    Params params;
+    Progress progress(nullptr, nullptr, GMPU_STAGE_ORIENT);
+    Workers workers(2);
+    const Octree tree = build_octree(ps, params, 1e-4, workers, progress);
+    assert_true(tree.cells.size() > 100);
+    const WindingField w(tree, ps, normals, area, &progress);
+    for (uint32_t c = 0; c < tree.cells.size(); ++c) {
+        const Cell &cell = tree.cells[c];
+        Vector3d centroid = Vector3d::Zero();
+        double total = 0.0;
+        for (uint32_t k = cell.point_begin; k < cell.point_end; ++k) {
+            centroid += double(area[tree.order[k]]) * ps.point(tree.order[k]);
+            total += double(area[tree.order[k]]);
+        }
+        double radius = 0.0;
+        if (total > 0.0) {
+            centroid /= total;
+            for (uint32_t k = cell.point_begin; k < cell.point_end; ++k)
+                radius = std::max(radius, (ps.point(tree.order[k]) - centroid).norm());
+        }
+        assert_near(w.radius(c), radius, 1e-9);
+    }
+}
+
 // ---- belief propagation ---------------------------------------------------------------
 
 void bp_follows_clamped_evidence(void **) {
@@ -888,6 +931,7 @@ int main(void) {
         cmocka_unit_test(point_set_normalises_and_searches),
         cmocka_unit_test(blend_finds_every_covering_leaf),
         cmocka_unit_test(winding_number_of_a_sampled_sphere),
+        cmocka_unit_test(winding_radii_hold_their_points),
         cmocka_unit_test(bp_follows_clamped_evidence),
         cmocka_unit_test(bp_data_term_breaks_ties_only),
         cmocka_unit_test(cube_cases_cut_sign_changes_outward),
