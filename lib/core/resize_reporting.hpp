@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <vector>
 
+#include "core/huge_pages.hpp"
 #include "core/progress.hpp"
 
 namespace gmpu {
@@ -17,6 +18,7 @@ void assign_reporting(std::vector<T> &v, size_t n, Progress &progress, const T &
     const size_t step = std::max<size_t>(1, kSliceBytes / sizeof(T));
     v.clear();
     v.reserve(n);
+    advise_huge_pages(v);
     while (v.size() < n) {
         progress.tick();
         v.resize(std::min(n, v.size() + step), value);

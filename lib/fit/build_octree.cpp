@@ -7,6 +7,7 @@
 #include <string>
 #include <thread>
 
+#include "core/huge_pages.hpp"
 #include "core/memory_budget.hpp"
 #include "core/parallel.hpp"
 #include "fit/cell_fit.hpp"
@@ -193,6 +194,8 @@ struct Builder {
     Octree run() {
         const size_t n = points.size();
         check_fit_memory(n, 1, params.max_memory);
+        tree.order.reserve(n);
+        advise_huge_pages(tree.order);
         tree.order.resize(n);
         std::iota(tree.order.begin(), tree.order.end(), 0u);
         // Room for the cells up front (address space only until used): growing the array by

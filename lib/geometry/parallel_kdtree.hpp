@@ -19,6 +19,7 @@
 
 #include <nanoflann.hpp>
 
+#include "core/huge_pages.hpp"
 #include "core/parallel.hpp"
 #include "core/progress.hpp"
 
@@ -79,6 +80,8 @@ void build_kdtree_in_parallel(Tree &tree, std::vector<std::unique_ptr<nanoflann:
     pools.clear();
     // What buildIndex() does before divideTree.
     tree.m_size = tree.dataset.kdtree_get_point_count();
+    tree.vAcc.reserve(tree.m_size);
+    advise_huge_pages(tree.vAcc);
     tree.init_vind();
     tree.freeIndex(tree);
     tree.m_size_at_index_build = tree.m_size;

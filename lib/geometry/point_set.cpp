@@ -9,6 +9,7 @@
 #include <nanoflann.hpp>
 
 #include "core/error.hpp"
+#include "core/huge_pages.hpp"
 #include "geometry/counting_result_set.hpp"
 #include "geometry/parallel_kdtree.hpp"
 
@@ -145,6 +146,8 @@ PointSet PointSet::from_array(const T *xyz, size_t count, size_t stride, size_t 
     set.world_diagonal_ = extent.stableNorm();
     set.box_min_ = set.norm_.to_unit(lo);
     set.box_max_ = set.norm_.to_unit(hi);
+    set.points_.reserve(3 * count);
+    advise_huge_pages(set.points_);
     set.points_.resize(3 * count);
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
     for (size_t i = 0; i < count; ++i) {

@@ -16,6 +16,13 @@
 
 namespace gmpu {
 
+// One representative per occupied voxel (cubes of side `voxel` from `origin`, 65,536 a side:
+// a point outside counts in the nearest edge voxel): the lowest point index in it and the
+// number of points it holds, in voxel order (z, then y, then x). Polls `progress` at
+// `fraction`.
+void voxel_representatives(const PointSet &points, const Eigen::Vector3d &origin, double voxel, Progress &progress,
+                           double fraction, std::vector<uint32_t> &rep, std::vector<uint32_t> &count);
+
 struct PointBuckets {
     std::vector<uint32_t> offsets;  // per band block (index into `band`), CSR into the two below
     std::vector<uint32_t> point;    // representative point index
