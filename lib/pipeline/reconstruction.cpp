@@ -6,12 +6,17 @@
 #include "fit/noise_estimate.hpp"
 #include "implicit/mpu_function.hpp"
 #include "mesh/polygonizer.hpp"
+#include "pipeline/free_sheet.hpp"
 #include "pipeline/smooth_normals.hpp"
 #include "pipeline/smooth_surface.hpp"
 
 namespace gmpu {
 
 namespace {
+
+// Where the free-sheet test looks, in noise σ off each point: far enough to be off the noisy
+// sheet, near enough to stay within a thin part.
+constexpr double kFreeSheetOffset = 2.0;
 
 // The end of a successful stage, before it commits its result: the final report (fraction
 // 1), after which nothing slow follows; a cancel on it counts.
@@ -72,8 +77,16 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
                                             pool, signs_progress);
     const MpuFunction mpu(tree, orientation.signs, 0);
     // Noise-limited fits: the noise estimate is a sizeable share of the ε the tree was fitted to.
-    measures = measure_points(mpu, points, pool, measures_progress, noise >= 0.25 * epsilon);
+    const bool noisy_fits = noise >= 0.25 * epsilon;
+    measures = measure_points(mpu, points, pool, measures_progress, noisy_fits);
     winding = WindingField(tree, points, measures.blend_normals, measures.area, &winding_progress);
+    // Noise-limited fits of a thin wall may make one free sheet of it (free_sheet.hpp); the
+    // smooth field, not the blend, can make a slab of that.
+    if (wants_smooth && noisy_fits &&
+        is_free_sheet(winding, points, measures.blend_normals, kFreeSheetOffset * noise, winding_progress)) {
+        split_sheet_faces(mpu, points, measures, pool, winding_progress);
+        winding = WindingField(tree, points, measures.blend_normals, measures.area, &winding_progress);
+    }
     std::shared_ptr<const SmoothField> new_smooth =
         wants_smooth ? solve_smooth_surface(params, tree, points, measures, noise, smooth_progress) : nullptr;
     // Where the surface is the smooth field, the point normals follow it.
