@@ -187,8 +187,9 @@ test-tsan: deps-test
 	@[ -f $(TSAN_BUILD)/build.ninja ] || meson setup $(TSAN_BUILD) -Db_sanitize=thread -Db_lundef=false \
 	  -Dtests=false -Doptimization=2 -Ddebug=true
 	ninja -C $(TSAN_BUILD) lib/libgmpu.so.1.0.0
-	cc -std=c11 -O1 -g -fsanitize=thread -Iinclude tests/c/test_concurrency.c -o $(TSAN_BUILD)/test_concurrency \
-	  -L$(TSAN_BUILD)/lib -lgmpu -lcmocka -lm -pthread -Wl,-rpath,$(abspath $(TSAN_BUILD))/lib
+	cc -std=c11 -O1 -g -fsanitize=thread -Iinclude tests/c/test_concurrency.c tests/c/abort_on_failure.c \
+	  -o $(TSAN_BUILD)/test_concurrency -L$(TSAN_BUILD)/lib -lgmpu -lcmocka -lm -pthread \
+	  -Wl,-rpath,$(abspath $(TSAN_BUILD))/lib
 	TSAN_OPTIONS=halt_on_error=1:second_deadlock_stack=1 $(TSAN_BUILD)/test_concurrency
 
 # valgrind memcheck on the release build: any error or definite leak fails.
