@@ -394,8 +394,10 @@ void Body::vertices(const Element &e, Parsed &out) {
         // Reserved, then filled record by record: the pages are touched as the ticks go.
         out.positions.reserve(3 * n);
         advise_huge_pages(out.positions);
-        if (has_normals) out.normals.reserve(3 * n);
-        advise_huge_pages(out.normals);
+        if (has_normals) {
+            out.normals.reserve(3 * n);
+            advise_huge_pages(out.normals);
+        }
         if (colours) out.colors.reserve(3 * n);
         double v[9];
         for (size_t i = 0; i < n; ++i) {

@@ -36,15 +36,13 @@ void voxel_representatives(const PointSet &points, const Eigen::Vector3d &origin
     rep.clear();
     count.clear();
     const size_t n = points.size();
-    uint32_t top = 0;
+    // start[z + 1]: the points in slab z, then (summed) where slab z + 1 begins.
+    std::vector<size_t> start(1, 0);
     for (uint32_t i = 0; i < n; ++i) {
         if (i % kPollEvery == 0) progress.poll(fraction);
-        top = std::max(top, voxel_of(points, i, origin, voxel)[2]);
-    }
-    std::vector<size_t> start(size_t(top) + 2, 0);
-    for (uint32_t i = 0; i < n; ++i) {
-        if (i % kPollEvery == 0) progress.poll(fraction);
-        ++start[size_t(voxel_of(points, i, origin, voxel)[2]) + 1];
+        const size_t z = voxel_of(points, i, origin, voxel)[2];
+        if (start.size() < z + 2) start.resize(z + 2, 0);
+        ++start[z + 1];
     }
     for (size_t z = 1; z < start.size(); ++z) start[z] += start[z - 1];
     std::vector<uint32_t> by_slab;

@@ -28,8 +28,8 @@ bool is_free_sheet(const WindingField &winding, const PointSet &points, const st
                    double offset, Progress &progress);
 
 // Turns the normals (both of `measures`' sets) of the points on the inside of `mpu` to face
-// away from the sheet's middle. Returns how many were turned.
-size_t split_sheet_faces(const MpuFunction &mpu, const PointSet &points, PointMeasures &measures, Workers &workers,
-                         Progress &progress);
+// away from the sheet's middle.
+void split_sheet_faces(const MpuFunction &mpu, const PointSet &points, PointMeasures &measures, Workers &workers,
+                       Progress &progress);
 
 }  // namespace gmpu
