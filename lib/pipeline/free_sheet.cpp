@@ -9,7 +9,7 @@ namespace {
 
 // Enough samples for stable medians; the test costs two winding queries each.
 constexpr size_t kSamples = 2000;
-// A closed surface's centre-to-jump ratio is ½ (measured 0.46–0.65 on noisy clouds, the
+// A closed surface's centre-to-jump ratio is ½ (measured 0.44–0.65 on noisy clouds, the
 // winding number's near field inflating both); a free sheet's is 0.
 constexpr double kFreeRatio = 0.125;
 // The jump must be there at all: offsets that cross a wall thinner than them land outside
