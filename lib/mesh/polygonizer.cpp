@@ -208,27 +208,42 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuck
 
 }  // namespace
 
+double median_leaf_size(const Octree &tree) {
+    std::vector<double> sizes;
+    for (const Cell &c : tree.cells)
+        if (c.is_leaf() && c.point_end > c.point_begin) sizes.push_back(c.size);
+    if (sizes.empty()) return INFINITY;
+    std::nth_element(sizes.begin(), sizes.begin() + long(sizes.size() / 2), sizes.end());
+    return sizes[sizes.size() / 2];
+}
+
+double thin_wall_gap(const Octree &tree) {
+    // The walls must hold a real share of the points: a few two-sheet leaves in a narrow slot
+    // would otherwise refine the whole grid.
+    std::vector<std::pair<double, uint32_t>> walls;  // gap, points
+    double points = 0.0;
+    for (const Cell &c : tree.cells) {
+        if (!c.is_leaf() || c.point_end == c.point_begin) continue;
+        points += double(c.point_end - c.point_begin);
+        if (c.shape.model == Model::two_sheets)
+            walls.push_back({tree.pieces[size_t(c.shape.piece)].sheet_gap(), c.point_end - c.point_begin});
+    }
+    std::sort(walls.begin(), walls.end());
+    double held = 0.0;
+    for (const auto &w : walls)
+        if ((held += w.second) >= kWallShare * points) return w.first;
+    return INFINITY;
+}
+
 int default_resolution(const Octree &tree, const PointMeasures &measures) {
     // Half the median size of the leaves that hold points (the grid then resolves every
     // local fit with about two cubes across), or finer where the points are dense:
     // kCubePerSpacing mean sample spacings (from the surface area the points stand for),
     // down to kFinestSizeCube. Where leaves hold two sheets, the cube must
     // also be well under their gap, or both sheets fall between two grid corners of the same
-    // sign and vanish. The walls that set it must hold a real share of the points: a few
-    // two-sheet leaves in a narrow slot would otherwise refine the whole grid.
-    std::vector<double> sizes;
-    std::vector<std::pair<double, uint32_t>> walls;  // gap, points
-    double points = 0.0;
-    for (const Cell &c : tree.cells) {
-        if (!c.is_leaf() || c.point_end == c.point_begin) continue;
-        sizes.push_back(c.size);
-        points += double(c.point_end - c.point_begin);
-        if (c.shape.model == Model::two_sheets)
-            walls.push_back({tree.pieces[size_t(c.shape.piece)].sheet_gap(), c.point_end - c.point_begin});
-    }
-    if (sizes.empty()) return 64;
-    std::nth_element(sizes.begin(), sizes.begin() + long(sizes.size() / 2), sizes.end());
-    const double leaf = sizes[sizes.size() / 2];
+    // sign and vanish.
+    const double leaf = median_leaf_size(tree);
+    if (!std::isfinite(leaf)) return 64;
     double area = 0.0;
     for (float a : measures.area) area += double(a);
     // Without areas (nothing measured): two cubes across the median leaf.
@@ -237,13 +252,7 @@ int default_resolution(const Octree &tree, const PointMeasures &measures) {
         const double sized = kCubePerSpacing * std::sqrt(area / double(measures.area.size()));
         h = std::min(std::max(sized, kFinestSizeCube), kCubesPerLeaf * leaf);
     }
-    std::sort(walls.begin(), walls.end());
-    double held = 0.0;
-    for (const auto &w : walls)
-        if ((held += w.second) >= kWallShare * points) {
-            h = std::min(h, kCubesPerGap * w.first);
-            break;
-        }
+    h = std::min(h, kCubesPerGap * thin_wall_gap(tree));
     return std::clamp(int(std::ceil(1.0 / h)), 32, 1024);
 }
 

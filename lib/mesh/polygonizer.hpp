@@ -22,6 +22,13 @@ namespace gmpu {
 // a thin wall's two sheets.
 int default_resolution(const Octree &tree, const PointMeasures &measures);
 
+// The median size of the leaves that hold points, INFINITY where none does.
+double median_leaf_size(const Octree &tree);
+
+// The gap between the two sheets of the thinnest walls that hold a real share of the points
+// (leaves fitted with two sheets), INFINITY where there are none.
+double thin_wall_gap(const Octree &tree);
+
 // The grid widens every point's trust radius to at least this at `resolution` (two cubes,
 // so every cube the surface crosses has its corners trusted); `evaluate` widens it the same.
 inline double grid_min_trust(int resolution) { return 2.0 / resolution; }

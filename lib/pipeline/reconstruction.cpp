@@ -5,6 +5,7 @@
 #include "fit/build_octree.hpp"
 #include "fit/noise_estimate.hpp"
 #include "implicit/mpu_function.hpp"
+#include "mesh/grid_budget.hpp"
 #include "mesh/polygonizer.hpp"
 #include "pipeline/free_sheet.hpp"
 #include "pipeline/smooth_normals.hpp"
@@ -94,7 +95,7 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
         Progress read_progress = smooth_progress.slice(1.0, 1.0);
         measures.normals = field_point_normals(*new_smooth, points, measures, read_progress);
     }
-    blend_grid = gmpu::default_resolution(tree, measures);
+    blend_grid = blend_resolution();
     smooth_grid = smooth_resolution(tree, measures);
     finish(progress);
     smooth = std::move(new_smooth);
@@ -116,7 +117,12 @@ Mesh Reconstruction::polygonize(const Params &params, int resolution, Progress &
 int Reconstruction::default_resolution(const Params &params) const {
     const bool wants_smooth = wants_smooth_surface(params, points, noise);
     if (blend_grid > 0) return wants_smooth ? smooth_grid : blend_grid;
-    return wants_smooth ? smooth_resolution(tree, measures) : gmpu::default_resolution(tree, measures);
+    return wants_smooth ? smooth_resolution(tree, measures) : blend_resolution();
+}
+
+int Reconstruction::blend_resolution() const {
+    return resolution_within_budget(gmpu::default_resolution(tree, measures), measures, noise, median_leaf_size(tree),
+                                    thin_wall_gap(tree));
 }
 
 bool Reconstruction::field_matches(const Params &params) const {

@@ -52,8 +52,11 @@ struct Reconstruction {
     // or drops the smooth field first when GMPU_PARAM_SURFACE changed since orient.
     Mesh polygonize(const Params &params, int resolution, Progress &progress);
     // Polygonize's grid when GMPU_PARAM_RESOLUTION is 0: the smooth field's when `params`
-    // asks for it, else the octree's (polygonizer.hpp: default_resolution).
+    // asks for it, else the blend's (blend_resolution).
     int default_resolution(const Params &params) const;
+    // The blend's grid: the octree's (polygonizer.hpp: default_resolution), coarsened to the
+    // mesh's triangle budget where the points are dense and clean (grid_budget.hpp).
+    int blend_resolution() const;
     // Whether the field matches `params`: the smooth field is there exactly when
     // GMPU_PARAM_SURFACE asks for it (false after the parameter changed since the last orient
     // or polygonize, until one of them solves or drops it).

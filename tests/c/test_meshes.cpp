@@ -361,6 +361,41 @@ void thin_wall_mesh_has_at_most_two_triangles_per_point(void **) {
     }
 }
 
+// A dense, clean torus fitted to a tight tolerance: the octree's small leaves ask for a grid
+// on which marching cubes would make several triangles per point. The default grid is made
+// coarse enough that the march alone stays within 2 per point: the default mesh is the mesh
+// of that grid set by the caller (nothing decimated), closed, one component, genus 1, every
+// vertex within twice the tolerance of the torus. Without the budget the default grid's
+// mesh is decimated and still over it (the tolerance bounds the decimation).
+void dense_clean_grid_fits_the_budget(void **) {
+    const Torus torus(Vec3(0, 0, 0), 1.0, 0.35);
+    const std::vector<Vec3> points = torus.sample(22000, 11).positions;
+    const double epsilon = 0.00003;  // of the diagonal
+    const std::vector<std::pair<gmpu_param, double>> tight = {{GMPU_PARAM_ERROR, epsilon}};
+    const Reconstruction r = reconstruct(points, tight);
+    assert_int_equal(r.status, GMPU_OK);
+    const double resolution = r.stat(GMPU_STAT_RESOLUTION);
+    std::vector<std::pair<gmpu_param, double>> same_grid = tight;
+    same_grid.push_back({GMPU_PARAM_RESOLUTION, resolution});
+    const Reconstruction full = reconstruct(points, same_grid);
+    assert_int_equal(full.status, GMPU_OK);
+    fprintf(stderr, "  resolution %.0f: %zu triangles (the same grid set by the caller: %zu) for %zu points\n",
+            resolution, r.mesh.triangles.size(), full.mesh.triangles.size(), points.size());
+    assert_true(r.mesh.triangles.size() <= 2 * points.size());
+    assert_int_equal(r.mesh.triangles.size(), full.mesh.triangles.size());
+    const MeshCheck c = check_mesh(r.mesh);
+    assert_true(c.watertight);
+    assert_int_equal(c.nonmanifold_vertices, 0);
+    assert_int_equal(c.components, 1);
+    assert_true(genera(c) == std::vector<int>({1}));
+    assert_true(c.signed_volume > 0);
+    const double diagonal = torus.bounds().diagonal().norm();
+    double worst = 0.0;
+    for (const auto &v : r.mesh.vertices) worst = std::max(worst, std::fabs(torus.signed_distance(v)));
+    fprintf(stderr, "  farthest vertex %.5f from the torus (diagonal %.2f)\n", worst, diagonal);
+    assert_true(worst < 2 * epsilon * diagonal);
+}
+
 // Every vertex lies on the implicit (a root of f along its grid edge), not on the linear
 // interpolant between the edge's corners, which is off by a share of a cube on the torus.
 void vertices_lie_on_the_implicit(void **) {
@@ -491,6 +526,7 @@ int main(void) {
         cmocka_unit_test(level_of_detail_keeps_the_topology_of_the_full_surface),
         cmocka_unit_test(mesh_size_follows_the_points),
         cmocka_unit_test(thin_wall_mesh_has_at_most_two_triangles_per_point),
+        cmocka_unit_test(dense_clean_grid_fits_the_budget),
         cmocka_unit_test(vertices_lie_on_the_implicit),
         cmocka_unit_test(sharp_edges_stay_sharp),
         cmocka_unit_test(noisy_vertices_stay_interpolated),
