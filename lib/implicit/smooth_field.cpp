@@ -4,8 +4,11 @@
 #include <cmath>
 #include <cstdint>
 
-#include <Eigen/Sparse>
+#include <array>
+#include <vector>
 
+#include "core/block_sums.hpp"
+#include "core/error.hpp"
 #include "core/memory_budget.hpp"
 #include "implicit/point_measures.hpp"
 
@@ -43,9 +46,11 @@ constexpr double kMaxReachSteps = 12.0;
 // small cost, fine enough to keep a thin wall's two sides apart where it hands over.
 constexpr double kOuterSteps = 2.0;
 // Memory model, for GMPU_PARAM_MAX_MEMORY: per node of a touched block, the splat's sums
-// (weight, distance, normal) and its index; per unknown, the field, the edges' matrix rows
-// and the solver's vectors; per point, its 8 trilinear weights and nodes.
-constexpr double kBytesPerSlotNode = 44, kBytesPerUnknown = 200, kBytesPerPoint = 100;
+// (weight, distance, normal) and its index; per unknown, the field, its six neighbours,
+// its row's start and the solver's vectors; per point, its 8 trilinear weights and nodes,
+// its entries in the blocks' and the rows' lists (about 8 blocks, 8 corners) and its value
+// in the products.
+constexpr double kBytesPerSlotNode = 44, kBytesPerUnknown = 200, kBytesPerPoint = 180;
 
 double weight(double d2, double r2) {
     const double t = 1.0 - d2 / r2;
@@ -62,7 +67,7 @@ int32_t SmoothField::node(int64_t x, int64_t y, int64_t z) const {
 }
 
 SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, double spacing, double min_trust,
-                         double noise, double max_memory, Progress &progress) {
+                         double noise, double max_memory, Workers &workers, Progress &progress) {
     if (points.size() == 0) return;
     max_reach_ = kMaxReachSteps * spacing;
     // The outer field: the same problem on a coarser grid over the whole box, solved first.
@@ -71,7 +76,7 @@ SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, 
     outer->max_reach_ = max_reach_;
     Progress outer_progress = progress.slice(0.0, 0.1);
     outer->solve(points, measures, measures.blend_normals, min_trust, noise, max_memory, nullptr, nullptr, true,
-                 kOuterIterations, outer_progress);
+                 kOuterIterations, workers, outer_progress);
     // The cascade: each coarser level (twice the step) solved first, its field the next
     // level's start.
     std::vector<double> steps{spacing};
@@ -85,13 +90,13 @@ SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, 
         Progress slice = progress.slice(0.1 + (levels - 1 - double(l)) / levels * 0.1,
                                         0.1 + (levels - double(l)) / levels * 0.1);
         level.solve(points, measures, measures.blend_normals, min_trust, noise, max_memory, coarse.empty() ? nullptr : &coarse,
-                    outer.get(), false, kMaxIterations, slice);
+                    outer.get(), false, kMaxIterations, workers, slice);
         coarse = std::move(level);
     }
     h_ = spacing;
     Progress fine = progress.slice(steps.size() > 1 ? 0.2 : 0.0, 1.0);
     const double shift = solve(points, measures, measures.blend_normals, min_trust, noise, max_memory,
-                               coarse.empty() ? nullptr : &coarse, outer.get(), false, kMaxIterations, fine);
+                               coarse.empty() ? nullptr : &coarse, outer.get(), false, kMaxIterations, workers, fine);
     // The fine level's zero set is the surface: the outer field follows its shift, so the
     // two agree where one hands over to the other.
     for (double &v : outer->values_) v -= shift;
@@ -101,7 +106,7 @@ SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, 
 
 SmoothField SmoothField::resolved(const PointSet &points, const PointMeasures &measures,
                                   const std::vector<float> &normals, double noise, double max_memory,
-                                  Progress &progress) const {
+                                  Workers &workers, Progress &progress) const {
     SmoothField next;
     if (empty()) return next;
     next.h_ = h_;
@@ -115,10 +120,10 @@ SmoothField SmoothField::resolved(const PointSet &points, const PointMeasures &m
     outer->max_reach_ = max_reach_;
     Progress outer_progress = progress.slice(0.0, 0.3);
     outer->solve(points, measures, normals, min_trust_, noise, max_memory, outer_.get(), nullptr, true, kOuterIterations,
-                 outer_progress);
+                 workers, outer_progress);
     Progress band_progress = progress.slice(0.3, 1.0);
     const double shift = next.solve(points, measures, normals, min_trust_, noise, max_memory, this, outer.get(), false,
-                                    kResolveIterations, band_progress);
+                                    kResolveIterations, workers, band_progress);
     for (double &v : outer->values_) v -= shift;
     next.outer_ = std::move(outer);
     return next;
@@ -126,7 +131,8 @@ SmoothField SmoothField::resolved(const PointSet &points, const PointMeasures &m
 
 double SmoothField::solve(const PointSet &points, const PointMeasures &measures, const std::vector<float> &normals,
                           double min_trust, double noise, double max_memory, const SmoothField *coarse,
-                          const SmoothField *boundary, bool whole_box, int iterations, Progress &progress) {
+                          const SmoothField *boundary, bool whole_box, int iterations, Workers &workers,
+                          Progress &progress) {
     const size_t n = points.size();
     auto radius = [&](size_t i) {
         return std::min(std::max(double(measures.trust_radius[i]), min_trust), max_reach_) + std::sqrt(3.0) * h_;
@@ -141,6 +147,9 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
     }
     const char *what = "the smooth surface's solve (GMPU_PARAM_SURFACE)";
     check_memory(double(blocks_[0]) * double(blocks_[1]) * double(blocks_[2]) * sizeof(int32_t), max_memory, what);
+    // A sample's corners are numbered 8 × its index in 32 bits (the rows' lists below).
+    if (8.0 * double(n) > double(UINT32_MAX))
+        throw Error(GMPU_ERROR_LIMIT_EXCEEDED, std::string(what) + " takes at most 536,870,911 points");
     block_slot_.assign(size_t(blocks_[0] * blocks_[1] * blocks_[2]), -1);
 
     // The nodes within each point's radius, a box of them per point.
@@ -181,25 +190,59 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
         return size_t(block_slot_[size_t(x / B + blocks_[0] * (y / B + blocks_[1] * (z / B)))]) * BBB +
                size_t(x % B + B * (y % B + B * (z % B)));
     };
-    for (size_t i = 0; i < n; ++i) {
-        if (i % 1024 == 0) progress.poll(0.05 + 0.15 * double(i) / double(n));
+    // Each block of nodes sums the points whose boxes reach it, in the points' order (so a
+    // node's sums do not depend on the thread count); the blocks run in parallel.
+    std::vector<uint32_t> block_start(size_t(slots) + 1, 0), block_points;
+    auto for_blocks = [&](size_t i, auto &&visit) {
         int64_t lo[3], hi[3];
         node_box(i, lo, hi);
-        const Eigen::Vector3d p = points.point(i);
-        const Eigen::Vector3d nrm(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);
-        const double r = radius(i), r2 = r * r;
-        for (int64_t z = lo[2]; z <= hi[2]; ++z)
-            for (int64_t y = lo[1]; y <= hi[1]; ++y)
-                for (int64_t x = lo[0]; x <= hi[0]; ++x) {
-                    const Eigen::Vector3d q = origin_ + h_ * Eigen::Vector3d(double(x), double(y), double(z));
-                    const double w = weight((q - p).squaredNorm(), r2);
-                    if (w <= 0.0) continue;
-                    const size_t s = slot_of(x, y, z);
-                    wsum[s] += w;
-                    normal[s] += w * nrm;
-                    distance[s] += w * (p - q).dot(nrm);  // inside (behind the normal): positive
-                }
+        for (int64_t z = lo[2] / B; z <= hi[2] / B; ++z)
+            for (int64_t y = lo[1] / B; y <= hi[1] / B; ++y)
+                for (int64_t x = lo[0] / B; x <= hi[0] / B; ++x)
+                    visit(size_t(block_slot_[size_t(x + blocks_[0] * (y + blocks_[1] * z))]));
+    };
+    for (size_t i = 0; i < n; ++i) {
+        if (i % 4096 == 0) progress.poll(0.05);
+        for_blocks(i, [&](size_t slot) { ++block_start[slot + 1]; });
     }
+    for (size_t b = 0; b < size_t(slots); ++b) block_start[b + 1] += block_start[b];
+    block_points.resize(block_start.back());
+    {
+        std::vector<uint32_t> fill(block_start.begin(), block_start.end() - 1);
+        for (size_t i = 0; i < n; ++i) {
+            if (i % 4096 == 0) progress.poll(0.05);
+            for_blocks(i, [&](size_t slot) { block_points[fill[slot]++] = uint32_t(i); });
+        }
+    }
+    std::vector<int64_t> slot_block(static_cast<size_t>(slots));
+    for (size_t b = 0; b < block_slot_.size(); ++b)
+        if (block_slot_[b] >= 0) slot_block[size_t(block_slot_[b])] = int64_t(b);
+    Progress splat_progress = progress.slice(0.05, 0.2);
+    parallel_for(0, size_t(slots), workers, splat_progress, [&](size_t slot) {
+        const int64_t b = slot_block[slot];
+        const int64_t base[3] = {B * (b % blocks_[0]), B * (b / blocks_[0] % blocks_[1]), B * (b / blocks_[0] / blocks_[1])};
+        for (uint32_t e = block_start[slot]; e < block_start[slot + 1]; ++e) {
+            const size_t i = block_points[e];
+            int64_t lo[3], hi[3];
+            node_box(i, lo, hi);
+            for (int d = 0; d < 3; ++d) lo[d] = std::max(lo[d], base[d]), hi[d] = std::min(hi[d], base[d] + B - 1);
+            const Eigen::Vector3d p = points.point(i);
+            const Eigen::Vector3d nrm(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);
+            const double r = radius(i), r2 = r * r;
+            for (int64_t z = lo[2]; z <= hi[2]; ++z)
+                for (int64_t y = lo[1]; y <= hi[1]; ++y)
+                    for (int64_t x = lo[0]; x <= hi[0]; ++x) {
+                        const Eigen::Vector3d q = origin_ + h_ * Eigen::Vector3d(double(x), double(y), double(z));
+                        const double w = weight((q - p).squaredNorm(), r2);
+                        if (w <= 0.0) continue;
+                        const size_t s = slot * BBB + size_t(x - base[0] + B * (y - base[1] + B * (z - base[2])));
+                        wsum[s] += w;
+                        normal[s] += w * nrm;
+                        distance[s] += w * (p - q).dot(nrm);  // inside (behind the normal): positive
+                    }
+        }
+    }, 1);
+    progress.throw_if_cancelled();
     node_index_.assign(slot_nodes, -1);
     int32_t unknowns = 0;
     for (size_t s = 0; s < slot_nodes; ++s)
@@ -211,10 +254,10 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
     // α Sᵀ D S is applied in factored form (8 weights per sample), far fewer products than
     // its 27-neighbour stencil assembled.
     Eigen::VectorXd rhs = Eigen::VectorXd::Zero(unknowns), start(unknowns);
-    std::vector<Eigen::Triplet<double>> entries;
-    entries.reserve(size_t(unknowns) * 6);
     std::vector<Eigen::Vector3d> field(static_cast<size_t>(unknowns));
-    for (int64_t z = 0; z < nodes_[2]; ++z)
+    Progress planes_progress = progress.slice(0.2, 0.2);  // the loops over planes only check for a cancel
+    parallel_for(0, size_t(nodes_[2]), workers, planes_progress, [&](size_t plane) {
+        const int64_t z = int64_t(plane);
         for (int64_t y = 0; y < nodes_[1]; ++y)
             for (int64_t x = 0; x < nodes_[0]; ++x) {
                 const int32_t u = node(x, y, z);
@@ -231,6 +274,8 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
                 const double length = field[size_t(u)].norm();
                 if (length > kAgreeing) field[size_t(u)] /= length;
             }
+    }, 1);
+    progress.throw_if_cancelled();
     if (whole_box && !coarse) {
         // Away from the points the start copies the nearest band node's (breadth first):
         // the exterior starts outside and enclosed regions on the side their band says,
@@ -263,25 +308,30 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
     std::vector<Eigen::Vector3d>().swap(normal);
     const double edge_weight = h_;  // Σ over edges of h·(Δf − h·V)² approximates ∫|∇f − V|²
     Eigen::VectorXd edge_diagonal = Eigen::VectorXd::Zero(unknowns);
-    for (int64_t z = 0; z < nodes_[2]; ++z) {
-        progress.poll(0.2 + 0.1 * double(z) / double(nodes_[2]));
+    // The edges' part of the matrix: every edge weighs the same, so it is the unknowns'
+    // neighbours (−x, +x, −y, +y, −z, +z; −1 where the band ends) and that weight.
+    std::vector<int32_t> neighbours(6 * size_t(unknowns), -1);
+    // Each unknown sums its own six edges (in a fixed order: −z, −y, −x, +x, +y, +z), so the
+    // planes run in parallel.
+    parallel_for(0, size_t(nodes_[2]), workers, planes_progress, [&](size_t plane) {
+        const int64_t z = int64_t(plane);
         for (int64_t y = 0; y < nodes_[1]; ++y)
             for (int64_t x = 0; x < nodes_[0]; ++x) {
                 const int32_t a = node(x, y, z);
                 if (a < 0) continue;
-                for (int d = 0; d < 3; ++d) {
-                    const int32_t b = node(x + (d == 0), y + (d == 1), z + (d == 2));
+                for (int side = 0; side < 6; ++side) {
+                    const int d = side < 3 ? 2 - side : side - 3, dir = side < 3 ? -1 : 1;
+                    const int32_t b = node(x + (d == 0) * dir, y + (d == 1) * dir, z + (d == 2) * dir);
                     if (b < 0) continue;
+                    // f should rise by `rise` from the lower node of the edge to the upper one.
                     const double rise = h_ * 0.5 * (field[size_t(a)][d] + field[size_t(b)][d]);
                     edge_diagonal[a] += edge_weight;
-                    edge_diagonal[b] += edge_weight;
-                    entries.emplace_back(a, b, -edge_weight);
-                    entries.emplace_back(b, a, -edge_weight);
-                    rhs[a] -= edge_weight * rise;
-                    rhs[b] += edge_weight * rise;
+                    neighbours[6 * size_t(a) + 2 * size_t(d) + (dir > 0)] = b;
+                    rhs[a] += dir > 0 ? -edge_weight * rise : edge_weight * rise;
                 }
             }
-    }
+    }, 1);
+    progress.throw_if_cancelled();
     // The band's edge: an edge to a node outside the band asks for the same rise towards the
     // outer field's value there (a Dirichlet condition). Left free, f would keep rising
     // along the normals to the band's edge: over a misoriented patch it rises outward and
@@ -307,9 +357,6 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
                         }
                 }
     std::vector<Eigen::Vector3d>().swap(field);
-    Eigen::SparseMatrix<double, Eigen::RowMajor> edges(unknowns, unknowns);
-    edges.setFromTriplets(entries.begin(), entries.end());
-    std::vector<Eigen::Triplet<double>>().swap(entries);
 
     const double knee = noise > 0.0 ? kNoiseKnee / noise : INFINITY;
     const double alpha =
@@ -342,39 +389,94 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
             diagonal[sample_node[8 * i + size_t(k)]] +=
                 sample_scale[i] * sample_weight[8 * i + size_t(k)] * sample_weight[8 * i + size_t(k)];
     }
-    auto apply = [&](const Eigen::VectorXd &v, Eigen::VectorXd &out) {
-        out.noalias() = edges * v;
-        out += edge_diagonal.cwiseProduct(v);
+    // The samples' part read per unknown: the (sample, corner) pairs that land on it, in
+    // sample order, so that each unknown's row sums alone (in parallel, in a fixed order).
+    std::vector<uint32_t> row_start(size_t(unknowns) + 1, 0), row_pairs;
+    for (size_t i = 0; i < n; ++i) {
+        if (i % 4096 == 0) progress.poll(0.4);
+        if (sample_scale[i] != 0.0)
+            for (int k = 0; k < 8; ++k) ++row_start[size_t(sample_node[8 * i + size_t(k)]) + 1];
+    }
+    for (size_t u = 0; u < size_t(unknowns); ++u) row_start[u + 1] += row_start[u];
+    row_pairs.resize(row_start.back());
+    {
+        std::vector<uint32_t> fill(row_start.begin(), row_start.end() - 1);
         for (size_t i = 0; i < n; ++i) {
-            if (sample_scale[i] == 0.0) continue;
-            const int32_t *idx = &sample_node[8 * i];
-            const double *w = &sample_weight[8 * i];
-            double at = 0.0;
-            for (int k = 0; k < 8; ++k) at += w[k] * v[idx[k]];
-            at *= sample_scale[i];
-            for (int k = 0; k < 8; ++k) out[idx[k]] += at * w[k];
+            if (i % 4096 == 0) progress.poll(0.4);
+            if (sample_scale[i] != 0.0)
+                for (int k = 0; k < 8; ++k) row_pairs[fill[size_t(sample_node[8 * i + size_t(k)])]++] = uint32_t(8 * i + size_t(k));
         }
+    }
+    Progress quiet = progress.slice(0.45, 0.45);  // the loops below only check for a cancel
+    std::vector<double> at_sample(n, 0.0);
+    auto apply = [&](const Eigen::VectorXd &v, Eigen::VectorXd &out) {
+        block_for(n, workers, quiet, [&](size_t lo, size_t hi) {
+            for (size_t i = lo; i < hi; ++i) {
+                if (sample_scale[i] == 0.0) continue;
+                const int32_t *idx = &sample_node[8 * i];
+                const double *w = &sample_weight[8 * i];
+                double at = 0.0;
+                for (int k = 0; k < 8; ++k) at += w[k] * v[idx[k]];
+                at_sample[i] = at * sample_scale[i];
+            }
+        });
+        block_for(size_t(unknowns), workers, quiet, [&](size_t lo, size_t hi) {
+            for (size_t u = lo; u < hi; ++u) {
+                double around = 0.0;
+                for (int j = 0; j < 6; ++j) {
+                    const int32_t b = neighbours[6 * u + size_t(j)];
+                    if (b >= 0) around += v[b];
+                }
+                double sum = edge_diagonal[Eigen::Index(u)] * v[Eigen::Index(u)] - edge_weight * around;
+                for (uint32_t e = row_start[u]; e < row_start[u + 1]; ++e)
+                    sum += at_sample[row_pairs[e] / 8] * sample_weight[row_pairs[e]];
+                out[Eigen::Index(u)] = sum;
+            }
+        });
     };
     progress.poll(0.45);
 
     // Jacobi-preconditioned conjugate gradients, polling between iterations.
     const Eigen::VectorXd inverse_diagonal = diagonal.cwiseInverse();
-    Eigen::VectorXd x = start, r(unknowns), Ap(unknowns);
+    Eigen::VectorXd x = start, r(unknowns), Ap(unknowns), z(unknowns), p(unknowns);
+    const size_t rows = size_t(unknowns);
     apply(x, Ap);
-    r = rhs - Ap;
-    Eigen::VectorXd z = inverse_diagonal.cwiseProduct(r), p = z;
-    double rz = r.dot(z);
-    const double target = kTolerance * kTolerance * std::max(rhs.squaredNorm(), 1e-300);
-    for (int it = 0; it < iterations && r.squaredNorm() > target; ++it) {
+    std::array<double, 2> rz_rr = block_sums<2>(rows, workers, quiet, [&](size_t lo, size_t hi) {
+        std::array<double, 2> sum{};
+        for (Eigen::Index u = Eigen::Index(lo); u < Eigen::Index(hi); ++u) {
+            r[u] = rhs[u] - Ap[u];
+            p[u] = z[u] = inverse_diagonal[u] * r[u];
+            sum[0] += r[u] * z[u], sum[1] += r[u] * r[u];
+        }
+        return sum;
+    });
+    const double target = kTolerance * kTolerance *
+                          std::max(block_sums<1>(rows, workers, quiet, [&](size_t lo, size_t hi) {
+                                       return std::array<double, 1>{rhs.segment(Eigen::Index(lo), Eigen::Index(hi - lo)).squaredNorm()};
+                                   })[0],
+                                   1e-300);
+    for (int it = 0; it < iterations && rz_rr[1] > target; ++it) {
         progress.poll(0.45 + 0.55 * double(it) / iterations);
         apply(p, Ap);
-        const double step = rz / p.dot(Ap);
-        x += step * p;
-        r -= step * Ap;
-        z = inverse_diagonal.cwiseProduct(r);
-        const double rz_next = r.dot(z);
-        p = z + (rz_next / rz) * p;
-        rz = rz_next;
+        const double pAp = block_sums<1>(rows, workers, quiet, [&](size_t lo, size_t hi) {
+            return std::array<double, 1>{p.segment(Eigen::Index(lo), Eigen::Index(hi - lo)).dot(Ap.segment(Eigen::Index(lo), Eigen::Index(hi - lo)))};
+        })[0];
+        const double step = rz_rr[0] / pAp;
+        const std::array<double, 2> next = block_sums<2>(rows, workers, quiet, [&](size_t lo, size_t hi) {
+            std::array<double, 2> sum{};
+            for (Eigen::Index u = Eigen::Index(lo); u < Eigen::Index(hi); ++u) {
+                x[u] += step * p[u];
+                r[u] -= step * Ap[u];
+                z[u] = inverse_diagonal[u] * r[u];
+                sum[0] += r[u] * z[u], sum[1] += r[u] * r[u];
+            }
+            return sum;
+        });
+        const double beta = next[0] / rz_rr[0];
+        block_for(rows, workers, quiet, [&](size_t lo, size_t hi) {
+            for (Eigen::Index u = Eigen::Index(lo); u < Eigen::Index(hi); ++u) p[u] = z[u] + beta * p[u];
+        });
+        rz_rr = next;
     }
     // The zero set through the samples on average: with weak screening the normals' integral
     // alone fixes f up to an offset, which would shrink or swell the whole surface.

@@ -38,6 +38,7 @@
 
 #include <Eigen/Core>
 
+#include "core/parallel.hpp"
 #include "core/progress.hpp"
 #include "geometry/point_set.hpp"
 
@@ -54,7 +55,7 @@ public:
     // each sample. Checks its memory estimate against `max_memory` (LIMIT_EXCEEDED) and
     // polls `progress`, which it reports to 1.
     SmoothField(const PointSet &points, const PointMeasures &measures, double spacing, double min_trust, double noise,
-                double max_memory, Progress &progress);
+                double max_memory, Workers &workers, Progress &progress);
 
     // f and optionally ∇f at x: the band's where it is defined, else the outer field's;
     // false outside the outer field's box (f is then undefined).
@@ -63,7 +64,7 @@ public:
     // The same problem solved again with `normals` (outward, 3 per point) in place of the
     // blend's, on the same grid and band edge, started from this field.
     SmoothField resolved(const PointSet &points, const PointMeasures &measures, const std::vector<float> &normals,
-                         double noise, double max_memory, Progress &progress) const;
+                         double noise, double max_memory, Workers &workers, Progress &progress) const;
 
     bool empty() const { return values_.empty(); }
     size_t unknowns() const { return values_.size(); }
@@ -75,7 +76,7 @@ private:
     // the band's edge its values; `whole_box` solves on every node of the box, not a band.
     double solve(const PointSet &points, const PointMeasures &measures, const std::vector<float> &normals,
                  double min_trust, double noise, double max_memory, const SmoothField *coarse,
-                 const SmoothField *boundary, bool whole_box, int iterations, Progress &progress);
+                 const SmoothField *boundary, bool whole_box, int iterations, Workers &workers, Progress &progress);
     // The band's own value (the fine grid only).
     bool band_value(const Eigen::Vector3d &x, double &f, Eigen::Vector3d *gradient) const;
     int32_t node(int64_t x, int64_t y, int64_t z) const;  // unknown index, -1 outside the band

@@ -89,7 +89,7 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
         winding = WindingField(tree, points, measures.blend_normals, measures.area, &winding_progress);
     }
     std::shared_ptr<const SmoothField> new_smooth =
-        wants_smooth ? solve_smooth_surface(params, tree, points, measures, noise, smooth_progress) : nullptr;
+        wants_smooth ? solve_smooth_surface(params, tree, points, measures, noise, pool, smooth_progress) : nullptr;
     // Where the surface is the smooth field, the point normals follow it.
     if (new_smooth) {
         Progress read_progress = smooth_progress.slice(1.0, 1.0);
@@ -110,7 +110,7 @@ Mesh Reconstruction::polygonize(const Params &params, int resolution, Progress &
     if (field_matches(params)) return gmpu::polygonize(field(params.level), resolution, params, pool, progress, noise);
     // The surface parameter changed since orient: solve or drop the smooth field first.
     Progress solve_progress = progress.slice(0.0, 0.3), march_progress = progress.slice(0.3, 1.0);
-    smooth = smooth ? nullptr : solve_smooth_surface(params, tree, points, measures, noise, solve_progress);
+    smooth = smooth ? nullptr : solve_smooth_surface(params, tree, points, measures, noise, pool, solve_progress);
     return gmpu::polygonize(field(params.level), resolution, params, pool, march_progress, noise);
 }
 

@@ -49,12 +49,12 @@ bool wants_smooth_surface(const Params &params, const PointSet &points, double n
 
 std::shared_ptr<const SmoothField> solve_smooth_surface(const Params &params, const Octree &tree,
                                                         const PointSet &points, const PointMeasures &measures,
-                                                        double noise, Progress &progress) {
+                                                        double noise, Workers &workers, Progress &progress) {
     const double h = 1.0 / smooth_resolution(tree, measures);
     const double noise_share = noise_fraction(points, noise);
     Progress first_progress = progress.slice(0.0, 0.7), normals_progress = progress.slice(0.7, 0.75),
              second_progress = progress.slice(0.75, 1.0);
-    SmoothField first(points, measures, h, 2.0 * h, noise_share, params.max_memory, first_progress);
+    SmoothField first(points, measures, h, 2.0 * h, noise_share, params.max_memory, workers, first_progress);
     // Solved again from its own normals at the points (where the neighbours agree): they
     // are the blend's normals averaged over the field's neighbourhood, far less noisy than
     // the blend's own at noise, and scattered flips are corrected.
@@ -64,7 +64,7 @@ std::shared_ptr<const SmoothField> solve_smooth_surface(const Params &params, co
     }
     const std::vector<float> normals = field_point_normals(first, points, measures, normals_progress);
     return std::make_shared<const SmoothField>(
-        first.resolved(points, measures, normals, noise_share, params.max_memory, second_progress));
+        first.resolved(points, measures, normals, noise_share, params.max_memory, workers, second_progress));
 }
 
 }  // namespace gmpu

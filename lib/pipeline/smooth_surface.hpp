@@ -23,10 +23,10 @@ bool wants_smooth_surface(const Params &params, const PointSet &points, double n
 int smooth_resolution(const Octree &tree, const PointMeasures &measures);
 
 // The smooth field of an oriented reconstruction, on the grid of smooth_resolution: solved
-// from the blend's normals, then again from its own normals at the points.
+// from the blend's normals, then again from its own normals at the points, on `workers`.
 // Reports `progress` to 1.
 std::shared_ptr<const SmoothField> solve_smooth_surface(const Params &params, const Octree &tree,
                                                         const PointSet &points, const PointMeasures &measures,
-                                                        double noise, Progress &progress);
+                                                        double noise, Workers &workers, Progress &progress);
 
 }  // namespace gmpu

@@ -85,8 +85,9 @@ void isolated_flips_follow_the_field(void **) {
         }
     const PointMeasures measures = measures_for(points, normals);
     Progress quiet(nullptr, nullptr, GMPU_STAGE_ORIENT);
+    Workers workers(2);
     const double h = 1.0 / 64;
-    const SmoothField field(points, measures, h, 2.0 * h, 0.005, 1e9, quiet);
+    const SmoothField field(points, measures, h, 2.0 * h, 0.005, 1e9, workers, quiet);
     const std::vector<float> out = field_point_normals(field, points, measures, quiet);
     size_t corrected = 0, right = 0;
     for (size_t i = 0; i < points.size(); ++i) {
@@ -119,8 +120,9 @@ void thin_wall_keeps_its_normals(void **) {
     const PointSet points = PointSet::from_array(xyz.data(), n, 0, 15);
     const PointMeasures measures = measures_for(points, normals);
     Progress quiet(nullptr, nullptr, GMPU_STAGE_ORIENT);
+    Workers workers(2);
     const double h = 1.0 / 128;
-    const SmoothField field(points, measures, h, 2.0 * h, 0.002, 1e9, quiet);
+    const SmoothField field(points, measures, h, 2.0 * h, 0.002, 1e9, workers, quiet);
     const std::vector<float> out = field_point_normals(field, points, measures, quiet);
     size_t right = 0;
     for (size_t i = 0; i < n; ++i) right += dot(out, normals, i) > 0.0;

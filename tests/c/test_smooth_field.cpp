@@ -88,7 +88,8 @@ void misoriented_cap_relaxes_outside(void **) {
 
     const double h = 1.0 / kResolution;
     Progress quiet(nullptr, nullptr, GMPU_STAGE_ORIENT);
-    const SmoothField field(points, measures, h, 2.0 * h, 0.01, 1e10, quiet);
+    Workers workers(2);
+    const SmoothField field(points, measures, h, 2.0 * h, 0.01, 1e10, workers, quiet);
     assert_false(field.empty());
 
     // Along the cap's axis, outward from a few cells beyond the noise: outside everywhere.
@@ -109,6 +110,35 @@ void misoriented_cap_relaxes_outside(void **) {
     assert_true(f < 0.0);
     assert_true(field.value(centre, f, nullptr));
     assert_true(f > 0.0);
+}
+
+// The solve's loops run on the workers in fixed blocks whose partial sums are added in
+// order: the field is the same to the last bit on 1, 2 and 3 threads (a reduction in the
+// order threads finish, or per thread, would differ in the last bits and, through the
+// conjugate gradients' steps, in far more).
+void same_field_on_any_thread_count(void **) {
+    const Cloud c = misoriented_cap_sphere();
+    const double h = 1.0 / kResolution;
+    std::vector<std::vector<double>> values;
+    for (unsigned threads : {1u, 2u, 3u}) {
+        Progress quiet(nullptr, nullptr, GMPU_STAGE_ORIENT);
+        Workers workers(threads);
+        const SmoothField field(c.points, c.measures, h, 2.0 * h, 0.01, 1e10, workers, quiet);
+        const SmoothField again = field.resolved(c.points, c.measures, c.measures.normals, 0.01, 1e10, workers, quiet);
+        std::vector<double> at;
+        for (double t = -1.2; t <= 1.2; t += 0.37 * h)
+            for (const SmoothField *f : {&field, &again}) {
+                double v = 0.0;
+                Eigen::Vector3d g = Eigen::Vector3d::Zero();
+                f->value(c.centre + c.radius * Vector3d(t, 0.3 * t, -0.2 * t), v, &g);
+                at.insert(at.end(), {v, g.x(), g.y(), g.z()});
+            }
+        values.push_back(at);
+    }
+    print_message("# %zu values and gradients compared\n", values[0].size());
+    assert_true(values[0].size() > 100);
+    assert_true(values[1] == values[0]);
+    assert_true(values[2] == values[0]);
 }
 
 // Where the zero set crosses the cap's axis, outward from the centre (in radii; 0 if
@@ -132,11 +162,12 @@ void resolved_follows_the_new_normals(void **) {
     const Cloud c = misoriented_cap_sphere();
     const double h = 1.0 / kResolution;
     Progress quiet(nullptr, nullptr, GMPU_STAGE_ORIENT);
-    const SmoothField first(c.points, c.measures, h, 2.0 * h, 0.01, 1e10, quiet);
-    const SmoothField second = first.resolved(c.points, c.measures, c.true_normals, 0.01, 1e10, quiet);
+    Workers workers(2);
+    const SmoothField first(c.points, c.measures, h, 2.0 * h, 0.01, 1e10, workers, quiet);
+    const SmoothField second = first.resolved(c.points, c.measures, c.true_normals, 0.01, 1e10, workers, quiet);
     PointMeasures right = c.measures;
     right.blend_normals = c.true_normals;
-    const SmoothField direct(c.points, right, h, 2.0 * h, 0.01, 1e10, quiet);
+    const SmoothField direct(c.points, right, h, 2.0 * h, 0.01, 1e10, workers, quiet);
     const double at_first = axis_crossing(first, c), at_second = axis_crossing(second, c),
                  at_direct = axis_crossing(direct, c);
     print_message("# cap axis crossing (radii): first %.4f, resolved %.4f, solved from the right normals %.4f\n",
@@ -164,7 +195,8 @@ void band_stays_near_scattered_points(void **) {
     measures.normals = measures.blend_normals;
     const double h = 1.0 / 64;
     Progress quiet(nullptr, nullptr, GMPU_STAGE_ORIENT);
-    const SmoothField field(points, measures, h, 2.0 * h, 0.01, 1e10, quiet);
+    Workers workers(2);
+    const SmoothField field(points, measures, h, 2.0 * h, 0.01, 1e10, workers, quiet);
     // Balls 16 steps wide, one per point, at most.
     const double bound = 8 * 4.0 / 3.0 * M_PI * std::pow(16.0, 3);
     print_message("# band unknowns %zu, bound %.0f\n", field.unknowns(), bound);
@@ -179,6 +211,7 @@ int main() {
         cmocka_unit_test(misoriented_cap_relaxes_outside),
         cmocka_unit_test(resolved_follows_the_new_normals),
         cmocka_unit_test(band_stays_near_scattered_points),
+        cmocka_unit_test(same_field_on_any_thread_count),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
