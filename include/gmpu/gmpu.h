@@ -134,9 +134,10 @@ typedef enum gmpu_param {
      * Discards a previous fit. Default 0, range 0..1. */
     GMPU_PARAM_SHARP_FEATURES = 5,
     /* Polygonize: grid cubes along the longest side of the points' bounding box.
-     * 0 picks one from the octree (fine enough for the detail the fit has) and decimates a
-     * mesh over 2 triangles per input point; otherwise at least 8, and every triangle of
-     * that grid is kept. Default 0, range 0..4096. */
+     * 0 picks one from the octree (fine enough for the detail the fit has; on dense, clean
+     * clouds coarsened towards 2 triangles per input point) and decimates a mesh still over
+     * 2 triangles per input point; otherwise at least 8, and every triangle of that grid is
+     * kept. Default 0, range 0..4096. */
     GMPU_PARAM_RESOLUTION = 6,
     /* Level of detail: evaluate and polygonize using octree cells down to this level
      * only (paper Fig. 7), and deeper only where a cell of this level fits its points worse
