@@ -23,6 +23,8 @@ constexpr double kAreaNoise = 0.1;
 // The coarsest cube across a thin wall's gap: at a whole gap both sheets can fall between two
 // corners of the same sign.
 constexpr double kCubesPerWallGap = 0.9;
+// Never coarser than the octree's default grid may be (polygonizer.cpp).
+constexpr int kCoarsestGrid = 32;
 }  // namespace
 
 int resolution_within_budget(int resolution, const PointMeasures &measures, double noise, double leaf,
@@ -36,7 +38,7 @@ int resolution_within_budget(int resolution, const PointMeasures &measures, doub
     if (!(noise < kAreaNoise * std::sqrt(area / points))) return resolution;
     double h = std::sqrt(kTrianglesPerCubeArea * area / budget);
     h = std::min({h, leaf, kCubesPerWallGap * wall_gap});
-    return std::min(resolution, std::max(1, int(1.0 / h)));
+    return std::min(resolution, std::max(kCoarsestGrid, int(1.0 / h)));
 }
 
 }  // namespace gmpu
