@@ -172,10 +172,13 @@ typedef enum gmpu_param {
     /* Which implicit evaluate and polygonize use. 0: the MPU blend of the local fits (the
      * paper's). 1: a smooth implicit solved over the whole cloud from the oriented points
      * (screened-Poisson-like least squares on a grid around the points), which averages the
-     * sampling noise instead of following it. 2: 1 where fit's estimated noise is at least
-     * 0.3 % of the bounding-box diagonal, else 0. Read by orient (which solves the smooth
-     * implicit) and polygonize (which solves or drops it if the value changed since).
-     * Default 2, range 0..2. */
+     * sampling noise instead of following it. 3: the blend held to within a quarter of the
+     * sample spacing of that smooth implicit: the blend's detail where the two agree, the
+     * smooth implicit's shape where the blend strays (past the end of a thin part, bridges
+     * between parts that nearly touch). 2: 1 where fit's estimated noise is at least 0.3 % of
+     * the bounding-box diagonal, else 3 on clouds of fewer than 20,000 points, else 0. Read
+     * by orient (which solves the smooth implicit) and polygonize (which solves or drops it
+     * if the value changed since). Default 2, range 0..3. */
     GMPU_PARAM_SURFACE = 14
 } gmpu_param;
 

@@ -74,11 +74,10 @@ double SurfaceField::value(const Eigen::Vector3d &x, Eigen::Vector3d *gradient) 
     if (!trusted(x)) {
         // The smooth field covers the box (its outer part): it, not the far field, meets
         // its own band's edge.
-        if (smooth_ && smooth_->value(x, v, gradient)) return v;
+        if (smooth_beyond_trust() && smooth_->value(x, v, gradient)) return v;
         return far_value(x, gradient);
     }
-    if (smooth_ && smooth_->value(x, v, gradient)) return v;
-    return mpu_.value(x, gradient);
+    return compose([&](Eigen::Vector3d *g) { return mpu_.value(x, g); }, x, gradient);
 }
 
 void SurfaceField::block_values(const LatticeBlock &block, const uint32_t *near, size_t near_count,
@@ -140,7 +139,7 @@ void SurfaceField::block_values(const LatticeBlock &block, const uint32_t *near,
                 double v;
                 if (trusted[at]) {
                     v = trusted_value(block.leaves_at(i, j, k), block.corner(i, j, k), nullptr);
-                } else if (smooth_ && smooth_->value(block.corner(i, j, k), v, nullptr)) {
+                } else if (smooth_beyond_trust() && smooth_->value(block.corner(i, j, k), v, nullptr)) {
                     // Untrusted, but inside the smooth field's box: its value, as in value().
                 } else {
                     // Trilinear in the coarse cell holding the corner.

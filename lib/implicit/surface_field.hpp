@@ -14,6 +14,8 @@
 // queries take its value instead of the blend's wherever it is defined, and untrusted ones
 // inside its box take its outer field instead of the far field (the two meet at the band's
 // edge with the same values, where the far sign could disagree).
+// Guided by the smooth field (guided_blend.hpp), trusted queries take the blend held to
+// the smooth field, and untrusted ones the far field, as for the blend alone.
 #pragma once
 
 #include <algorithm>
@@ -25,6 +27,7 @@
 
 #include "geometry/point_set.hpp"
 #include "implicit/far_value_cache.hpp"
+#include "implicit/guided_blend.hpp"
 #include "implicit/mpu_function.hpp"
 #include "implicit/point_measures.hpp"
 #include "implicit/smooth_field.hpp"
@@ -58,11 +61,12 @@ public:
     // `winding` (built from the same measures) signs the far field where it is decisive
     // (see far_value); an empty one leaves it to the side test. All are kept by reference
     // except the blend, a small view.
-    // `smooth` (may be null or empty) replaces the blend where it is defined.
+    // `smooth` (may be null or empty) replaces the blend where it is defined, or with a
+    // finite `guide_limit` (normalised units) guides it (guided_blend.hpp).
     SurfaceField(const MpuFunction &mpu, const PointSet &points, const PointMeasures &measures,
-                 const WindingField &winding, const SmoothField *smooth = nullptr)
+                 const WindingField &winding, const SmoothField *smooth = nullptr, double guide_limit = INFINITY)
         : mpu_(mpu), points_(points), measures_(measures), winding_(winding),
-          smooth_(smooth && !smooth->empty() ? smooth : nullptr) {}
+          smooth_(smooth && !smooth->empty() ? smooth : nullptr), guide_limit_(guide_limit) {}
 
     // The same field for a polygonizer's grid: `min_trust` widens every trust radius to at
     // least that (two cube sizes, so every cube the surface crosses has its corners
@@ -91,12 +95,10 @@ public:
                       double *values, FarValueCache *far_cache = nullptr) const;
 
     // The trusted value at x (the caller knows x is trusted): the smooth field's where it
-    // is defined, else the MPU blend's among `leaves`.
+    // is defined (guiding the MPU blend's, if so made), else the MPU blend's among `leaves`.
     double trusted_value(const std::vector<uint32_t> &leaves, const Eigen::Vector3d &x,
                          Eigen::Vector3d *gradient) const {
-        double v;
-        if (smooth_ && smooth_->value(x, v, gradient)) return v;
-        return mpu_.value_among(leaves, x, gradient);
+        return compose([&](Eigen::Vector3d *g) { return mpu_.value_among(leaves, x, g); }, x, gradient);
     }
 
     // Whether x lies within some point's trust radius (widened to min_trust).
@@ -107,17 +109,38 @@ public:
     double trust_radius(uint32_t i) const { return std::max(double(measures_.trust_radius[i]), min_trust_); }
     double widest_trust() const { return std::max(measures_.widest_trust, min_trust_); }
 
+    // Whether the smooth field guides the blend rather than replacing it.
+    bool guided() const { return smooth_ && std::isfinite(guide_limit_); }
+    // Whether untrusted queries take the smooth field's (outer) value, not the far field.
+    bool smooth_beyond_trust() const { return smooth_ && !guided(); }
+
     const MpuFunction &mpu() const { return mpu_; }
     const PointSet &points() const { return points_; }
     const PointMeasures &measures() const { return measures_; }
     const WindingField &winding() const { return winding_; }
 
 private:
+    // The trusted value from `blend(gradient)`, the blend's value at x.
+    template <class Blend>
+    double compose(const Blend &blend, const Eigen::Vector3d &x, Eigen::Vector3d *gradient) const {
+        double s;
+        if (!smooth_) return blend(gradient);
+        if (!guided()) return smooth_->value(x, s, gradient) ? s : blend(gradient);
+        Eigen::Vector3d gs, gb;
+        const double b = blend(gradient ? &gb : nullptr);
+        if (!smooth_->value(x, s, gradient ? &gs : nullptr)) {
+            if (gradient) *gradient = gb;
+            return b;
+        }
+        return guided_value(b, s, guide_limit_, &gb, &gs, gradient);
+    }
+
     MpuFunction mpu_;
     const PointSet &points_;
     const PointMeasures &measures_;
     const WindingField &winding_;
     const SmoothField *smooth_ = nullptr;
+    double guide_limit_ = INFINITY;
     double min_trust_ = 0.0, search_bound_ = INFINITY;
 };
 

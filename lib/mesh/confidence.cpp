@@ -90,16 +90,51 @@ void compute_confidence(Mesh &mesh, const PointSet &points, const PointMeasures 
     });
 }
 
+namespace {
+
+// Trimmed pieces of fewer triangles than this (and under half the trimmed mesh) are slivers
+// of invented surface that came within the threshold of the data, not scanned surface.
+constexpr size_t kMinPieceTriangles = 8;
+
+// Per triangle of `triangles` (3 vertex indices each, vertex_count vertices): whether it
+// lies in a piece (triangles joined by shared vertices) of at least kMinPieceTriangles.
+std::vector<bool> in_real_pieces(const std::vector<uint32_t> &triangles, size_t vertex_count) {
+    std::vector<uint32_t> parent(vertex_count);
+    for (size_t v = 0; v < vertex_count; ++v) parent[v] = uint32_t(v);
+    auto root = [&](uint32_t v) {
+        while (parent[v] != v) v = parent[v] = parent[parent[v]];
+        return v;
+    };
+    for (size_t t = 0; t < triangles.size(); t += 3)
+        for (int k = 1; k < 3; ++k) parent[root(triangles[t + size_t(k)])] = root(triangles[t]);
+    std::vector<size_t> piece_triangles(vertex_count, 0);
+    for (size_t t = 0; t < triangles.size(); t += 3) ++piece_triangles[root(triangles[t])];
+    const size_t count = triangles.size() / 3;
+    std::vector<bool> real(count);
+    for (size_t t = 0; t < count; ++t) {
+        const size_t size = piece_triangles[root(triangles[3 * t])];
+        real[t] = size >= kMinPieceTriangles || 2 * size >= count;
+    }
+    return real;
+}
+
+}  // namespace
+
 Mesh trim_unsupported(const Mesh &mesh, double threshold) {
-    Mesh out;
-    std::vector<uint32_t> index(mesh.vertex_count(), UINT32_MAX);
-    const bool normals = mesh.normals.size() == mesh.vertices.size();
+    std::vector<uint32_t> kept;
     for (size_t t = 0; t < mesh.triangles.size(); t += 3) {
         bool supported = true;
         for (int k = 0; k < 3; ++k) supported = supported && mesh.confidence[mesh.triangles[t + k]] <= threshold;
-        if (!supported) continue;
+        if (supported) kept.insert(kept.end(), mesh.triangles.begin() + long(t), mesh.triangles.begin() + long(t) + 3);
+    }
+    const std::vector<bool> real = in_real_pieces(kept, mesh.vertex_count());
+    Mesh out;
+    std::vector<uint32_t> index(mesh.vertex_count(), UINT32_MAX);
+    const bool normals = mesh.normals.size() == mesh.vertices.size();
+    for (size_t t = 0; t < kept.size(); t += 3) {
+        if (!real[t / 3]) continue;
         for (int k = 0; k < 3; ++k) {
-            const uint32_t v = mesh.triangles[t + k];
+            const uint32_t v = kept[t + size_t(k)];
             if (index[v] == UINT32_MAX) {
                 index[v] = uint32_t(out.vertex_count());
                 out.vertices.insert(out.vertices.end(), mesh.vertices.begin() + 3 * v, mesh.vertices.begin() + 3 * v + 3);

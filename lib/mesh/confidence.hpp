@@ -20,8 +20,10 @@ namespace gmpu {
 void compute_confidence(Mesh &mesh, const PointSet &points, const PointMeasures &measures, Workers &workers,
                         Progress &progress);
 
-// Removes every triangle with a vertex whose confidence is above `threshold`, and the
-// vertices left unused: the caps over holes go, leaving boundaries where the data ends.
+// Removes every triangle with a vertex whose confidence is above `threshold`, then the
+// pieces of fewer than 8 triangles left apart (slivers of a cap that passed within the
+// threshold of the data; kept if they are half the mesh), and the vertices left unused: the
+// caps over holes go, leaving boundaries where the data ends.
 // The mesh must carry a confidence.
 Mesh trim_unsupported(const Mesh &mesh, double threshold);
 

@@ -1,6 +1,7 @@
 #include "pipeline/reconstruction.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "fit/build_octree.hpp"
 #include "fit/noise_estimate.hpp"
@@ -43,8 +44,10 @@ void Reconstruction::discard_fit() {
     measures = PointMeasures();
     winding = WindingField();
     smooth.reset();
+    guide = INFINITY;
     orient_stats = {};
     blend_grid = smooth_grid = 0;
+    thin_walls = false;
 }
 
 void Reconstruction::fit(const Params &params, Progress &progress) {
@@ -59,13 +62,15 @@ void Reconstruction::fit(const Params &params, Progress &progress) {
     tree = std::move(new_tree);
     noise = new_noise;
     epsilon = new_epsilon;
+    thin_walls = std::isfinite(thin_wall_gap(tree));
 }
 
 void Reconstruction::orient(const Params &params, Progress &progress) {
     Workers &pool = workers(params.threads);
     progress.report(0.0, true);
     // The steps' shares of the stage's progress.
-    const bool wants_smooth = wants_smooth_surface(params, points, noise);
+    const SurfaceKind kind = surface_kind(params, points, noise, thin_walls);
+    const bool wants_smooth = needs_smooth_field(kind);
     const double signs_end = wants_smooth ? 0.8 : 0.9, winding_end = wants_smooth ? 0.85 : 1.0;
     Progress signs_progress = progress.slice(0.0, signs_end), measures_progress = progress.slice(signs_end, signs_end + 0.05),
              winding_progress = progress.slice(signs_end + 0.05, winding_end),
@@ -74,6 +79,7 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
     // can use as it is.
     winding = WindingField();
     smooth.reset();
+    guide = INFINITY;
     Orientation orientation = orient_octree(tree, points, input_normals.empty() ? nullptr : input_normals.data(),
                                             pool, signs_progress);
     const MpuFunction mpu(tree, orientation.signs, 0);
@@ -99,6 +105,7 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
     smooth_grid = smooth_resolution(tree, measures);
     finish(progress);
     smooth = std::move(new_smooth);
+    guide = kind == SurfaceKind::guided_blend ? guide_limit(measures) : INFINITY;
     signs = std::move(orientation.signs);
     orient_stats = orientation.stats;
 }
@@ -110,14 +117,18 @@ Mesh Reconstruction::polygonize(const Params &params, int resolution, Progress &
     if (field_matches(params)) return gmpu::polygonize(field(params.level), resolution, params, pool, progress, noise);
     // The surface parameter changed since orient: solve or drop the smooth field first.
     Progress solve_progress = progress.slice(0.0, 0.3), march_progress = progress.slice(0.3, 1.0);
-    smooth = smooth ? nullptr : solve_smooth_surface(params, tree, points, measures, noise, pool, solve_progress);
+    const SurfaceKind kind = surface_kind(params, points, noise, thin_walls);
+    if (!needs_smooth_field(kind)) smooth.reset();
+    else if (!smooth) smooth = solve_smooth_surface(params, tree, points, measures, noise, pool, solve_progress);
+    guide = kind == SurfaceKind::guided_blend ? guide_limit(measures) : INFINITY;
     return gmpu::polygonize(field(params.level), resolution, params, pool, march_progress, noise);
 }
 
 int Reconstruction::default_resolution(const Params &params) const {
-    const bool wants_smooth = wants_smooth_surface(params, points, noise);
-    if (blend_grid > 0) return wants_smooth ? smooth_grid : blend_grid;
-    return wants_smooth ? smooth_resolution(tree, measures) : blend_resolution();
+    // The guided blend's detail is the blend's: its grid too.
+    const bool smooth_grid_wanted = surface_kind(params, points, noise, thin_walls) == SurfaceKind::smooth;
+    if (blend_grid > 0) return smooth_grid_wanted ? smooth_grid : blend_grid;
+    return smooth_grid_wanted ? smooth_resolution(tree, measures) : blend_resolution();
 }
 
 int Reconstruction::blend_resolution() const {
@@ -126,7 +137,10 @@ int Reconstruction::blend_resolution() const {
 }
 
 bool Reconstruction::field_matches(const Params &params) const {
-    return wants_smooth_surface(params, points, noise) == bool(smooth);
+    const SurfaceKind current = !smooth                 ? SurfaceKind::blend
+                                : std::isfinite(guide) ? SurfaceKind::guided_blend
+                                                       : SurfaceKind::smooth;
+    return surface_kind(params, points, noise, thin_walls) == current;
 }
 
 void Reconstruction::evaluate(const Params &params, const double *xyz, size_t count, double *values,

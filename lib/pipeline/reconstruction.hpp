@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstddef>
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -37,11 +38,15 @@ struct Reconstruction {
     // The smooth field (pipeline/smooth_surface.hpp) when GMPU_PARAM_SURFACE asked for it
     // at the last orient or polygonize; null: the MPU blend.
     std::shared_ptr<const SmoothField> smooth;
+    // With the smooth field: the limit to which it holds the blend (implicit/guided_blend.hpp),
+    // or ∞ where it replaces the blend.
+    double guide = INFINITY;
     OrientStats orient_stats;
     // The default grids of the last orient, blend's and smooth field's: evaluate asks for one
     // on every call, and each is a pass over every cell and point.
     int blend_grid = 0, smooth_grid = 0;
     double noise = 0.0, epsilon = 0.0;     // of the last fit, normalised units
+    bool thin_walls = false;               // whether the last fit found any (polygonizer.hpp: thin_wall_gap)
 
     // Fit: noise estimate, ε, adaptive octree of local fits.
     void fit(const Params &params, Progress &progress);
@@ -52,14 +57,14 @@ struct Reconstruction {
     // or drops the smooth field first when GMPU_PARAM_SURFACE changed since orient.
     Mesh polygonize(const Params &params, int resolution, Progress &progress);
     // Polygonize's grid when GMPU_PARAM_RESOLUTION is 0: the smooth field's when `params`
-    // asks for it, else the blend's (blend_resolution).
+    // asks for it alone, else the blend's (blend_resolution).
     int default_resolution(const Params &params) const;
     // The blend's grid: the octree's (polygonizer.hpp: default_resolution), coarsened to the
     // mesh's triangle budget where the points are dense and clean (grid_budget.hpp).
     int blend_resolution() const;
-    // Whether the field matches `params`: the smooth field is there exactly when
-    // GMPU_PARAM_SURFACE asks for it (false after the parameter changed since the last orient
-    // or polygonize, until one of them solves or drops it).
+    // Whether the field matches `params`: the smooth field is there, and guides or replaces
+    // the blend, as GMPU_PARAM_SURFACE asks (false after the parameter changed since the last
+    // orient or polygonize, until one of them solves, drops or re-purposes it).
     bool field_matches(const Params &params) const;
     // f and ∇f (world frame values, unit-free gradients) at `count` world points; either
     // output may be null. Requires an oriented reconstruction whose field matches `params`.
@@ -69,7 +74,7 @@ struct Reconstruction {
     // leaves): the one field evaluate and polygonize both ask. A view: valid while this
     // reconstruction is not changed.
     SurfaceField field(int level) const {
-        return SurfaceField(MpuFunction(tree, signs, level), points, measures, winding, smooth.get());
+        return SurfaceField(MpuFunction(tree, signs, level), points, measures, winding, smooth.get(), guide);
     }
 
     // Forget fit and orient (the points stay).

@@ -21,10 +21,27 @@ constexpr int kMaxResolution = 1024;
 // smoothed version moves the surface; below it the second solve changes little and costs
 // as much.
 constexpr double kResolveFromNoise = 0.0075;
+// GMPU_PARAM_SURFACE = 2 guides the blend on noise-free clouds of fewer points than this
+// (unless the fit found thin walls): there leaves hold few points and the blend strays past
+// thin parts' ends; on denser clouds the blend alone is as close, and the smooth solve would
+// cost several times the rest of the run.
+constexpr size_t kGuideBelowPoints = 20000;
+// The guided blend's limit, in median sample spacings: enough for the blend's detail
+// (sharp edges, thin walls) to stand, short of its strays.
+constexpr double kGuideSpacings = 0.25;
 
 double noise_fraction(const PointSet &points, double noise) {
     const double diagonal = points.world_diagonal() * points.normalisation().scale;  // normalised
     return diagonal > 0.0 ? noise / diagonal : 0.0;
+}
+
+// The points' typical spacing: the square root of the median area a point stands for (0
+// without areas).
+double median_spacing(const PointMeasures &measures) {
+    std::vector<float> area(measures.area);
+    if (area.empty()) return 0.0;
+    std::nth_element(area.begin(), area.begin() + long(area.size() / 2), area.end());
+    return std::sqrt(double(area[area.size() / 2]));
 }
 }  // namespace
 
@@ -33,19 +50,23 @@ int smooth_resolution(const Octree &tree, const PointMeasures &measures) {
     // octree stops early: its cube can be several point spacings, coarser than the detail the
     // noise-averaged surface still has. The smooth grid is at least as fine as the points'
     // typical spacing (the square root of the median area a point stands for).
-    std::vector<float> area(measures.area);
-    if (area.empty()) return default_resolution(tree, measures);
-    std::nth_element(area.begin(), area.begin() + long(area.size() / 2), area.end());
-    const double spacing = std::sqrt(double(area[area.size() / 2]));
+    const double spacing = median_spacing(measures);
     const int from_spacing = spacing > 0.0 ? int(std::ceil(1.0 / spacing)) : 0;
     return std::clamp(std::max(default_resolution(tree, measures), from_spacing), 8, kMaxResolution);
 }
 
-bool wants_smooth_surface(const Params &params, const PointSet &points, double noise) {
-    if (params.surface == 0) return false;
-    if (params.surface == 1) return true;
-    return noise_fraction(points, noise) >= kSmoothFromNoise;
+SurfaceKind surface_kind(const Params &params, const PointSet &points, double noise, bool thin_walls) {
+    switch (params.surface) {
+    case 0: return SurfaceKind::blend;
+    case 1: return SurfaceKind::smooth;
+    case 3: return SurfaceKind::guided_blend;
+    default:
+        if (noise_fraction(points, noise) >= kSmoothFromNoise) return SurfaceKind::smooth;
+        return points.size() < kGuideBelowPoints && !thin_walls ? SurfaceKind::guided_blend : SurfaceKind::blend;
+    }
 }
+
+double guide_limit(const PointMeasures &measures) { return kGuideSpacings * median_spacing(measures); }
 
 std::shared_ptr<const SmoothField> solve_smooth_surface(const Params &params, const Octree &tree,
                                                         const PointSet &points, const PointMeasures &measures,

@@ -20,6 +20,7 @@
 #include "sampling.hpp"
 #include "reconstruct.hpp"
 #include "triangle_mesh.hpp"
+#include "mesh/confidence.hpp"
 
 #include <setjmp.h>
 #include <stdarg.h>
@@ -212,6 +213,33 @@ void trim_opens_the_hole(void **) {
     for (const Vec3 &p : t.vertices) assert_true(std::fabs(p.norm() - r) < 0.1 * r);
     gmpu_mesh_destroy(trimmed);
     gmpu_mesh_destroy(m);
+}
+
+// Trimming leaves no slivers: a piece of fewer than 8 triangles apart from the rest (a bit
+// of a cap that passed within the threshold of the data) goes with the cap, unless it is
+// half the trimmed mesh or more.
+void trim_drops_slivers_apart(void **) {
+    gmpu::Mesh mesh;
+    auto vertex = [&mesh](double x, double y) {
+        mesh.vertices.insert(mesh.vertices.end(), {x, y, 0.0});
+        mesh.confidence.push_back(0.0);
+        return uint32_t(mesh.confidence.size() - 1);
+    };
+    // A fan of 10 triangles around a centre, and one triangle apart: every vertex supported.
+    const uint32_t centre = vertex(0, 0);
+    std::vector<uint32_t> rim;
+    for (int k = 0; k < 10; ++k) rim.push_back(vertex(std::cos(0.6 * k), std::sin(0.6 * k)));
+    for (int k = 0; k + 1 < 10; ++k) mesh.triangles.insert(mesh.triangles.end(), {centre, rim[k], rim[k + 1]});
+    mesh.triangles.insert(mesh.triangles.end(), {centre, rim[9], rim[0]});
+    const uint32_t a = vertex(5, 0), b = vertex(6, 0), c = vertex(5, 1);
+    mesh.triangles.insert(mesh.triangles.end(), {a, b, c});
+    const gmpu::Mesh trimmed = gmpu::trim_unsupported(mesh, 3.0);
+    assert_int_equal(trimmed.triangle_count(), 10);
+    assert_int_equal(trimmed.vertex_count(), 11);
+    // The lone triangle alone is the whole trimmed mesh: kept.
+    gmpu::Mesh lone = mesh;
+    lone.triangles.assign({a, b, c});
+    assert_int_equal(gmpu::trim_unsupported(lone, 3.0).triangle_count(), 1);
 }
 
 // The same half-scanned sphere trimmed at 1.5 spacings: past the rim the data has ended,
@@ -522,6 +550,7 @@ int main(void) {
         cmocka_unit_test(simplify_bad_arguments),
         cmocka_unit_test(trim_opens_the_hole),
         cmocka_unit_test(trim_stops_at_the_rim),
+        cmocka_unit_test(trim_drops_slivers_apart),
         cmocka_unit_test(confidence_in_ply),
         cmocka_unit_test(level_of_detail_keeps_the_topology_of_the_full_surface),
         cmocka_unit_test(mesh_size_follows_the_points),

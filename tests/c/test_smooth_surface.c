@@ -19,6 +19,8 @@
 
 enum { kPoints = 20000 };
 static const double kMajor = 1.0, kMinor = 0.4;
+/* The fewest points on which the automatic choice leaves a noise-free cloud to the blend. */
+enum { kDenseCloud = 20000 };
 /* The torus's bounding-box diagonal: 2(R + r) × 2(R + r) × 2r. */
 static double diagonal(void) {
     const double w = 2 * (kMajor + kMinor), h = 2 * kMinor;
@@ -137,10 +139,11 @@ static void test_noisy_torus_keeps_its_topology(void **state) {
     free(xyz);
 }
 
-/* Without noise the automatic choice keeps the MPU blend: the same values as surface = 0. */
+/* Without noise, on 20,000 points and more, the automatic choice keeps the MPU blend: the
+ * same values as surface = 0 (fewer points guide it, tests/c/test_guided_blend.cpp). */
 static void test_clean_cloud_keeps_the_blend(void **state) {
     (void)state;
-    double *xyz = noisy_torus(6000, 0.0, 3);
+    double *xyz = noisy_torus(kDenseCloud, 0.0, 3);
     assert_non_null(xyz);
     gmpu_surface *automatic = NULL, *blend = NULL;
     assert_ok(gmpu_surface_create(&automatic));
@@ -148,22 +151,28 @@ static void test_clean_cloud_keeps_the_blend(void **state) {
     assert_ok(gmpu_surface_set_param(blend, GMPU_PARAM_SURFACE, 0));
     gmpu_surface *both[2] = {automatic, blend};
     for (int k = 0; k < 2; ++k) {
-        assert_ok(gmpu_surface_set_points_f64(both[k], xyz, 6000, 0));
+        assert_ok(gmpu_surface_set_points_f64(both[k], xyz, kDenseCloud, 0));
         assert_ok(gmpu_surface_fit(both[k]));
         assert_ok(gmpu_surface_orient(both[k]));
     }
-    const double q[6] = {kMajor + 0.05, 0, 0.1, 0.3, 1.2, -0.2};
-    double a[2], b[2];
-    assert_ok(gmpu_surface_evaluate(automatic, q, 2, a, NULL));
-    assert_ok(gmpu_surface_evaluate(blend, q, 2, b, NULL));
-    assert_true(a[0] == b[0] && a[1] == b[1]);
+    /* Across the tube, through its inside and out: where the blend and the smooth field
+     * differ by more than the guide's limit, a guided blend would answer otherwise. */
+    enum { kQueries = 64 };
+    double q[3 * kQueries], a[kQueries], b[kQueries];
+    for (int i = 0; i < kQueries; ++i) {
+        const double angle = 0.1 * i, across = kMajor + kMinor * (-1.5 + 3.0 * i / (kQueries - 1));
+        q[3 * i] = across * cos(angle), q[3 * i + 1] = across * sin(angle), q[3 * i + 2] = 0.05;
+    }
+    assert_ok(gmpu_surface_evaluate(automatic, q, kQueries, a, NULL));
+    assert_ok(gmpu_surface_evaluate(blend, q, kQueries, b, NULL));
+    for (int i = 0; i < kQueries; ++i) assert_true(a[i] == b[i]);
     gmpu_surface_destroy(automatic);
     gmpu_surface_destroy(blend);
     free(xyz);
 }
 
 /* The parameter is read and bounded like every other; changing it after orient is honoured
- * by polygonize (which solves or drops the smooth field), and evaluate refuses until then
+ * by polygonize (which solves, drops or re-purposes the smooth field), and evaluate refuses until then
  * rather than answer from the other surface; the solve checks its memory estimate against
  * the budget before allocating. */
 static void test_surface_parameter(void **state) {
@@ -173,7 +182,8 @@ static void test_surface_parameter(void **state) {
     assert_ok(gmpu_surface_create(&s));
     assert_ok(gmpu_surface_get_param(s, GMPU_PARAM_SURFACE, &v));
     assert_true(v == 2);
-    check_failure(gmpu_surface_set_param(s, GMPU_PARAM_SURFACE, 3), GMPU_ERROR_INVALID_ARGUMENT, "SURFACE");
+    check_failure(gmpu_surface_set_param(s, GMPU_PARAM_SURFACE, 4), GMPU_ERROR_INVALID_ARGUMENT, "SURFACE");
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_SURFACE, 0));
     double *xyz = noisy_torus(3000, 0.0, 9);
     assert_non_null(xyz);
     assert_ok(gmpu_surface_set_points_f64(s, xyz, 3000, 0));
@@ -190,6 +200,16 @@ static void test_surface_parameter(void **state) {
     gmpu_mesh_destroy(m);
     assert_ok(gmpu_surface_evaluate(s, q, 1, &smooth, NULL));
     assert_true(smooth != blend);
+    /* Guided (3): the same smooth field now holds the blend, again only once polygonize ran. */
+    double guided = 0;
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_SURFACE, 3));
+    check_failure(gmpu_surface_evaluate(s, q, 1, &guided, NULL), GMPU_ERROR_WRONG_ORDER, "GMPU_PARAM_SURFACE");
+    assert_ok(gmpu_surface_polygonize(s, &m));
+    assert_null(robust_mesh_problem(m));
+    gmpu_mesh_destroy(m);
+    assert_ok(gmpu_surface_evaluate(s, q, 1, &guided, NULL));
+    assert_true(fabs(guided - smooth) <= fabs(blend - smooth));
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_SURFACE, 1));
     assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_MAX_MEMORY, 1e6));
     m = NULL;
     check_failure2(gmpu_surface_orient(s), GMPU_ERROR_LIMIT_EXCEEDED, "smooth surface", "GMPU_PARAM_MAX_MEMORY");
