@@ -35,6 +35,7 @@ BlockGrid::BlockGrid(const PointSet &points, int resolution, const std::vector<f
     }
     mark_band(points, trust_radius, min_trust, progress);
     sign_far_regions(winding, progress);
+    while (band_sign_seams()) sign_far_regions(winding, progress);
 }
 
 Eigen::AlignedBox3d BlockGrid::block_box(int64_t id) const {
@@ -99,6 +100,26 @@ void BlockGrid::sign_far_regions(const WindingField &winding, Progress &progress
     far_sign.assign(size_t(nb), 0);
     for (int64_t b = 0; b < nb; ++b)
         if (!band[size_t(b)]) far_sign[size_t(b)] = region_sign[size_t(region[size_t(b)])];
+}
+
+bool BlockGrid::band_sign_seams() {
+    std::vector<int64_t> seams;
+    for (int64_t b = 0; b < int64_t(band.size()); ++b) {
+        if (far_sign[size_t(b)] <= 0) continue;
+        int64_t p[3];
+        block_position(b, p);
+        bool meets_outside = false;
+        for (int64_t dz = -1; dz <= 1 && !meets_outside; ++dz)
+            for (int64_t dy = -1; dy <= 1 && !meets_outside; ++dy)
+                for (int64_t dx = -1; dx <= 1 && !meets_outside; ++dx) {
+                    const int64_t x = p[0] + dx, y = p[1] + dy, z = p[2] + dz;
+                    if (x < 0 || y < 0 || z < 0 || x >= blocks[0] || y >= blocks[1] || z >= blocks[2]) continue;
+                    meets_outside = far_sign[size_t(block_id(x, y, z))] < 0;
+                }
+        if (meets_outside) seams.push_back(b);
+    }
+    for (int64_t b : seams) band[size_t(b)] = 1;
+    return !seams.empty();
 }
 
 bool BlockGrid::touches_far(int64_t id) const {

@@ -3,7 +3,9 @@
 // blocks form connected far regions, each wholly inside or outside: the one touching the
 // grid's edge is outside; enclosed ones (cavities, the inside of thick parts) ask the
 // winding number once. A corner touching a far block takes its region's sign, so the
-// band's border never changes sign within a region and every surface closes inside it.
+// band's border never changes sign within a region and every surface closes inside it;
+// where regions of opposite signs meet across an edge or a corner, the inside blocks there
+// join the band.
 #pragma once
 
 #include <cstdint>
@@ -61,6 +63,11 @@ struct BlockGrid {
 private:
     void mark_band(const PointSet &points, const std::vector<float> &trust_radius, double min_trust, Progress &progress);
     void sign_far_regions(const WindingField &winding, Progress &progress);
+    // Adds to the band every inside far block that meets an outside one across an edge or a
+    // corner only (the regions are face-connected, so two of opposite signs can touch so):
+    // the corners they share take the outside's sign, so the surface passes through the
+    // inside block, which must then be marched. Returns whether it added any.
+    bool band_sign_seams();
 };
 
 }  // namespace gmpu
