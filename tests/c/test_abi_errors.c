@@ -41,6 +41,7 @@ static gmpu_surface *new_surface(void) {
     assert_ok(gmpu_surface_create(&s));
     assert_non_null(s);
     assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_RESOLUTION, 24)); /* quick polygonize */
+    assert_ok(gmpu_surface_set_param(s, GMPU_PARAM_SURFACE, 0));     /* quick orient: no smooth solve */
     return s;
 }
 
