@@ -176,7 +176,8 @@ typedef enum gmpu_param {
      * sample spacing of that smooth implicit: the blend's detail where the two agree, the
      * smooth implicit's shape where the blend strays (past the end of a thin part, bridges
      * between parts that nearly touch). 2: 1 where fit's estimated noise is at least 0.3 % of
-     * the bounding-box diagonal, else 3 on clouds of fewer than 20,000 points, else 0. Read
+     * the bounding-box diagonal, else 3 on clouds of fewer than 20,000 points in which fit
+     * found no thin walls (two sheets in one leaf), else 0. Read
      * by orient (which solves the smooth implicit) and polygonize (which solves or drops it
      * if the value changed since). Default 2, range 0..3. */
     GMPU_PARAM_SURFACE = 14
