@@ -66,8 +66,9 @@ static const char *usage =
     "  (written to .ply and .glb).\n"
     "  --keep-outliers fits the outliers found (points far from all others) too; by default\n"
     "  they are reported and set aside.\n"
-    "  --trim[=T]  remove surface farther than T sample spacings from every point (default 3):\n"
-    "              the caps over a scan's holes go, leaving an open mesh\n"
+    "  --trim[=T]  cut away surface farther than T sample spacings from every point where it\n"
+    "              rises to 2T (default 1.5): the caps over a scan's holes go, leaving an\n"
+    "              open mesh\n"
     "  --target-triangles N, --target-error E  decimate to at most N triangles, moving the\n"
     "              surface by at most E x the diagonal (topology kept)\n"
     "  Options take their value as the next argument or after '=' (--resolution=64).\n"
@@ -138,8 +139,9 @@ enum { OPT_NORMALS_OUT = 256, OPT_ERROR, OPT_MAX_DEPTH, OPT_RESOLUTION, OPT_LEVE
        OPT_SHARP, OPT_NOISE_SCALE, OPT_MAX_MEMORY, OPT_PARAM, OPT_KEEP_OUTLIERS, OPT_TRIM, OPT_TARGET_TRIANGLES,
        OPT_TARGET_ERROR };
 
-/* Sample spacings beyond which --trim drops surface: the caps over holes are farther. */
-#define DEFAULT_TRIM 3.0
+/* Sample spacings beyond which --trim cuts surface (where it rises to twice that): the
+ * caps over holes rise farther. */
+#define DEFAULT_TRIM 1.5
 
 static const struct option long_options[] = {
     {"output", required_argument, NULL, 'o'},

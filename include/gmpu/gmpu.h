@@ -463,9 +463,13 @@ GMPU_API gmpu_status gmpu_mesh_color_from_points(const gmpu_mesh *mesh, const gm
 GMPU_API gmpu_status gmpu_mesh_simplify(const gmpu_mesh *mesh, size_t target_triangles, double target_error,
                                         gmpu_mesh **out);
 
-/* Trimming an open scan: a new mesh without the triangles that have a vertex whose
- * confidence is above threshold (in sample spacings; 1.2 to 3 removes the caps polygonize
- * closes holes with), so the result has boundaries where the data has holes. Errors:
+/* Trimming an open scan: a new mesh cut where the confidence (in sample spacings, linear
+ * along each edge) passes threshold, within the regions over it that rise to twice the
+ * threshold somewhere: the caps polygonize closes holes with go (0.75 to 2 removes them;
+ * 1.5 is the CLI's default), while spots just over it inside the scanned surface stay, so
+ * the result has boundaries where the data has holes and nowhere else. Triangles across
+ * the cut are clipped (new vertices, their confidence the threshold); pieces of fewer
+ * than 8 triangles left apart are dropped unless they are half the result. Errors:
  * INVALID_ARGUMENT (NULL, threshold not finite and positive, a mesh without confidence),
  * OUT_OF_MEMORY. */
 GMPU_API gmpu_status gmpu_mesh_trim(const gmpu_mesh *mesh, double threshold, gmpu_mesh **out);

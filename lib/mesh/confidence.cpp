@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <unordered_map>
 #include <vector>
 
 #include "core/parallel.hpp"
@@ -95,6 +97,14 @@ namespace {
 // Trimmed pieces of fewer triangles than this (and under half the trimmed mesh) are slivers
 // of invented surface that came within the threshold of the data, not scanned surface.
 constexpr size_t kMinPieceTriangles = 8;
+// A cut closer to the supported end of an edge than this share of it is made at that vertex
+// (the triangles it would leave are slivers).
+constexpr double kMinCut = 0.02;
+// Surface over the threshold is cut where it is part of a region that rises to this many
+// times the threshold: the caps over holes rise far from the data, while a random gap in
+// the sampling or the noise lifts a few vertices just over it inside the scanned surface,
+// which cutting would perforate.
+constexpr double kSeedFactor = 2.0;
 
 // Per triangle of `triangles` (3 vertex indices each, vertex_count vertices): whether it
 // lies in a piece (triangles joined by shared vertices) of at least kMinPieceTriangles.
@@ -118,30 +128,105 @@ std::vector<bool> in_real_pieces(const std::vector<uint32_t> &triangles, size_t 
     return real;
 }
 
+// Per vertex: whether the trim takes it away, i.e. its confidence is over `threshold` in a
+// region (vertices over it, joined by edges) that reaches kSeedFactor × threshold somewhere.
+std::vector<bool> unsupported_regions(const Mesh &mesh, double threshold) {
+    const size_t n = mesh.vertex_count();
+    std::vector<uint32_t> parent(n);
+    for (size_t v = 0; v < n; ++v) parent[v] = uint32_t(v);
+    auto root = [&](uint32_t v) {
+        while (parent[v] != v) v = parent[v] = parent[parent[v]];
+        return v;
+    };
+    auto over = [&](uint32_t v) { return !(mesh.confidence[v] <= threshold); };
+    for (size_t t = 0; t < mesh.triangles.size(); t += 3)
+        for (int k = 0; k < 3; ++k) {
+            const uint32_t a = mesh.triangles[t + size_t(k)], b = mesh.triangles[t + size_t(k + 1) % 3];
+            if (over(a) && over(b)) parent[root(a)] = root(b);
+        }
+    std::vector<bool> seeded(n, false), away(n, false);
+    for (size_t v = 0; v < n; ++v)
+        if (!(mesh.confidence[v] <= kSeedFactor * threshold)) seeded[root(uint32_t(v))] = true;
+    for (size_t v = 0; v < n; ++v) away[v] = over(uint32_t(v)) && seeded[root(uint32_t(v))];
+    return away;
+}
+
 }  // namespace
 
 Mesh trim_unsupported(const Mesh &mesh, double threshold) {
-    std::vector<uint32_t> kept;
-    for (size_t t = 0; t < mesh.triangles.size(); t += 3) {
-        bool supported = true;
-        for (int k = 0; k < 3; ++k) supported = supported && mesh.confidence[mesh.triangles[t + k]] <= threshold;
-        if (supported) kept.insert(kept.end(), mesh.triangles.begin() + long(t), mesh.triangles.begin() + long(t) + 3);
-    }
-    const std::vector<bool> real = in_real_pieces(kept, mesh.vertex_count());
-    Mesh out;
-    std::vector<uint32_t> index(mesh.vertex_count(), UINT32_MAX);
     const bool normals = mesh.normals.size() == mesh.vertices.size();
+    const bool colors = mesh.colors.size() == mesh.vertices.size();
+    // Every vertex first, then the cuts; unused ones are left out at the end.
+    Mesh all;
+    all.vertices = mesh.vertices;
+    all.confidence = mesh.confidence;
+    if (normals) all.normals = mesh.normals;
+    if (colors) all.colors = mesh.colors;
+    const std::vector<bool> cut_away = unsupported_regions(mesh, threshold);
+    auto supported = [&](uint32_t v) { return !cut_away[v]; };
+    // The vertex where the confidence, linear along the edge from `in` (supported) to `out`,
+    // reaches the threshold: one per edge, so the two triangles sharing it share the cut.
+    std::unordered_map<uint64_t, uint32_t> cuts;
+    auto cut = [&](uint32_t in, uint32_t out) {
+        const uint64_t key = uint64_t(in) << 32 | out;
+        const auto found = cuts.find(key);
+        if (found != cuts.end()) return found->second;
+        const double from = std::min(mesh.confidence[in], threshold), rise = mesh.confidence[out] - from;
+        const double t = std::isfinite(rise) && rise > 0.0 ? (threshold - from) / rise : 0.0;
+        uint32_t v = in;
+        if (t >= kMinCut) {
+            v = uint32_t(all.vertex_count());
+            for (int d = 0; d < 3; ++d)
+                all.vertices.push_back((1 - t) * mesh.vertices[3 * in + d] + t * mesh.vertices[3 * out + d]);
+            all.confidence.push_back(threshold);
+            if (normals) {
+                Eigen::Vector3d n;
+                for (int d = 0; d < 3; ++d) n[d] = (1 - t) * mesh.normals[3 * in + d] + t * mesh.normals[3 * out + d];
+                if (n.squaredNorm() > 0.0) n.normalize();
+                all.normals.insert(all.normals.end(), {n[0], n[1], n[2]});
+            }
+            if (colors)
+                for (int d = 0; d < 3; ++d)
+                    all.colors.push_back(uint8_t(std::lround((1 - t) * mesh.colors[3 * in + d] + t * mesh.colors[3 * out + d])));
+        }
+        cuts.emplace(key, v);
+        return v;
+    };
+    std::vector<uint32_t> kept;
+    auto keep = [&](uint32_t a, uint32_t b, uint32_t c) {
+        if (a != b && b != c && c != a) kept.insert(kept.end(), {a, b, c});
+    };
+    for (size_t t = 0; t < mesh.triangles.size(); t += 3) {
+        const uint32_t *v = &mesh.triangles[t];
+        const int inside = supported(v[0]) + supported(v[1]) + supported(v[2]);
+        if (inside == 3) keep(v[0], v[1], v[2]);
+        if (inside == 0 || inside == 3) continue;
+        // Rotated (keeping the winding) so that v[k] is the lone supported vertex (one inside)
+        // or the lone unsupported one (two inside).
+        int k = 0;
+        while ((supported(v[k]) == 1) != (inside == 1)) ++k;
+        const uint32_t a = v[k], b = v[(k + 1) % 3], c = v[(k + 2) % 3];
+        if (inside == 1) {
+            keep(a, cut(a, b), cut(a, c));
+        } else {
+            const uint32_t ab = cut(b, a), ca = cut(c, a);
+            keep(b, c, ca);
+            keep(ca, ab, b);
+        }
+    }
+    const std::vector<bool> real = in_real_pieces(kept, all.vertex_count());
+    Mesh out;
+    std::vector<uint32_t> index(all.vertex_count(), UINT32_MAX);
     for (size_t t = 0; t < kept.size(); t += 3) {
         if (!real[t / 3]) continue;
         for (int k = 0; k < 3; ++k) {
             const uint32_t v = kept[t + size_t(k)];
             if (index[v] == UINT32_MAX) {
                 index[v] = uint32_t(out.vertex_count());
-                out.vertices.insert(out.vertices.end(), mesh.vertices.begin() + 3 * v, mesh.vertices.begin() + 3 * v + 3);
-                if (normals) out.normals.insert(out.normals.end(), mesh.normals.begin() + 3 * v, mesh.normals.begin() + 3 * v + 3);
-                out.confidence.push_back(mesh.confidence[v]);
-                if (!mesh.colors.empty())
-                    out.colors.insert(out.colors.end(), mesh.colors.begin() + 3 * v, mesh.colors.begin() + 3 * v + 3);
+                out.vertices.insert(out.vertices.end(), all.vertices.begin() + 3 * v, all.vertices.begin() + 3 * v + 3);
+                if (normals) out.normals.insert(out.normals.end(), all.normals.begin() + 3 * v, all.normals.begin() + 3 * v + 3);
+                out.confidence.push_back(all.confidence[v]);
+                if (colors) out.colors.insert(out.colors.end(), all.colors.begin() + 3 * v, all.colors.begin() + 3 * v + 3);
             }
             out.triangles.push_back(index[v]);
         }

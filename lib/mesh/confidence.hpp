@@ -20,11 +20,12 @@ namespace gmpu {
 void compute_confidence(Mesh &mesh, const PointSet &points, const PointMeasures &measures, Workers &workers,
                         Progress &progress);
 
-// Removes every triangle with a vertex whose confidence is above `threshold`, then the
-// pieces of fewer than 8 triangles left apart (slivers of a cap that passed within the
-// threshold of the data; kept if they are half the mesh), and the vertices left unused: the
-// caps over holes go, leaving boundaries where the data ends.
-// The mesh must carry a confidence.
+// Cuts the mesh where its confidence, linear along each edge, passes `threshold`, keeping
+// the supported side (triangles across the cut are clipped, not dropped, so the boundary
+// follows the threshold however coarse the triangles), then removes the pieces of fewer
+// than 8 triangles left apart (slivers of a cap that passed within the threshold of the
+// data; kept if they are half the mesh), and the vertices left unused: the caps over holes
+// go, leaving boundaries where the data ends. The mesh must carry a confidence.
 Mesh trim_unsupported(const Mesh &mesh, double threshold);
 
 }  // namespace gmpu

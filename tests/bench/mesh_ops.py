@@ -149,11 +149,11 @@ def trim(args, tmp):
                          "recall_0.5": m.get("recall_0.5"), "fscore_0.5": m.get("fscore_0.5"),
                          "watertight": m["watertight"], "boundary_edges": m["boundary_edges"]})
             print(rows[-1], flush=True)
-    print("\n| cloud | pipeline | precision @0.5 % | recall @0.5 % | F@0.5 % | watertight |")
-    print("|---|---|---|---|---|---|")
+    print("\n| cloud | pipeline | precision @0.5 % | recall @0.5 % | F@0.5 % | watertight | boundary edges |")
+    print("|---|---|---|---|---|---|---|")
     for r in rows:
         print(f"| {r['cloud']} | {r['pipeline']} | {r['precision_0.5']:.4f} | {r['recall_0.5']:.4f} | "
-              f"{r['fscore_0.5']:.4f} | {r['watertight']} |")
+              f"{r['fscore_0.5']:.4f} | {r['watertight']} | {r['boundary_edges']} |")
     return rows
 
 
@@ -255,7 +255,7 @@ def main():
     ap.add_argument("--sections", default="decimation,lod,trim,size,dense,sharp")
     ap.add_argument("--corpus", type=Path, default=ROOT / "bench-results" / "corpus" / "clouds",
                     help="directory of the generated corpus clouds (tests/data/corpus/make.sh)")
-    ap.add_argument("--trim-values", type=lambda s: [float(x) for x in s.split(",") if x], default=[2.0, 1.5])
+    ap.add_argument("--trim-values", type=lambda s: [float(x) for x in s.split(",") if x], default=[2.0, 1.0, 0.75])
     ap.add_argument("--no-open3d", dest="open3d", action="store_false")
     ap.add_argument("--clouds", type=lambda s: [x for x in s.split(",") if x], default=[],
                     help="size: only the clouds whose name holds one of these")

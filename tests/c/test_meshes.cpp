@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <string>
 #include <unistd.h>
 #include <vector>
@@ -56,6 +57,10 @@ gmpu_mesh *polygonize(const std::vector<Vec3> &points, const std::vector<std::pa
 TriangleMesh arrays(const gmpu_mesh *m) {
     return mesh_from_arrays(gmpu_mesh_vertices(m), gmpu_mesh_vertex_count(m), gmpu_mesh_triangles(m),
                             gmpu_mesh_triangle_count(m));
+}
+
+TriangleMesh arrays_of(const gmpu::Mesh &m) {
+    return mesh_from_arrays(m.vertices.data(), m.vertex_count(), m.triangles.data(), m.triangle_count());
 }
 
 // Largest distance from any vertex of `from` to the surface of `to`.
@@ -253,7 +258,7 @@ void meshes_close_where_far_regions_meet_across_an_edge(void **) {
 void trim_drops_slivers_apart(void **) {
     gmpu::Mesh mesh;
     auto vertex = [&mesh](double x, double y) {
-        mesh.vertices.insert(mesh.vertices.end(), {x, y, 0.0});
+        for (double c : {x, y, 0.0}) mesh.vertices.push_back(c);
         mesh.confidence.push_back(0.0);
         return uint32_t(mesh.confidence.size() - 1);
     };
@@ -274,11 +279,77 @@ void trim_drops_slivers_apart(void **) {
     assert_int_equal(gmpu::trim_unsupported(lone, 3.0).triangle_count(), 1);
 }
 
+// A flat square grid of 2 × 2 cells whose confidence rises along x from 0 to 4 (0, 2, 4 at
+// the columns): trimmed at 1, the triangles across the threshold are clipped where the
+// confidence, linear along their edges, reaches 1, so the boundary is the line x = 0.5 across
+// the first column of cells, not the edge of the cells kept whole (which would leave
+// nothing: every cell has a vertex over 1).
+gmpu::Mesh flat_grid(int cells, const std::function<double(int, int)> &confidence) {
+    gmpu::Mesh mesh;
+    for (int j = 0; j <= cells; ++j)
+        for (int i = 0; i <= cells; ++i) {
+            for (double c : {double(i), double(j), 0.0}) mesh.vertices.push_back(c);
+            mesh.confidence.push_back(confidence(i, j));
+        }
+    auto at = [cells](int i, int j) { return uint32_t(j * (cells + 1) + i); };
+    for (int j = 0; j < cells; ++j)
+        for (int i = 0; i < cells; ++i)
+            for (uint32_t v : {at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j), at(i + 1, j + 1), at(i, j + 1)})
+                mesh.triangles.push_back(v);
+    return mesh;
+}
+
+void trim_clips_triangles_at_the_threshold(void **) {
+    const gmpu::Mesh mesh = flat_grid(2, [](int i, int) { return 2.0 * i; });
+    const gmpu::Mesh trimmed = gmpu::trim_unsupported(mesh, 1.0);
+    assert_true(trimmed.triangle_count() > 0);
+    double widest = 0.0, area = 0.0;
+    for (size_t v = 0; v < trimmed.vertex_count(); ++v) {
+        widest = std::max(widest, trimmed.vertices[3 * v]);
+        assert_true(trimmed.confidence[v] <= 1.0);
+    }
+    for (size_t t = 0; t < trimmed.triangle_count(); ++t) {
+        const double *a = &trimmed.vertices[3 * trimmed.triangles[3 * t]], *b = &trimmed.vertices[3 * trimmed.triangles[3 * t + 1]],
+                     *c = &trimmed.vertices[3 * trimmed.triangles[3 * t + 2]];
+        const double z = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);  // twice the signed area
+        assert_true(z > 0.0);  // the winding kept
+        area += z / 2;
+    }
+    assert_true(std::fabs(widest - 0.5) < 1e-12);
+    assert_true(std::fabs(area - 2 * 0.5) < 1e-12);  // the strip 0 ≤ x ≤ 0.5 of the 2 × 2 square
+    const MeshCheck check = check_mesh(arrays_of(trimmed));
+    assert_int_equal(check.nonmanifold_edges, 0);
+    assert_int_equal(check.components, 1);
+}
+
+// Inside the scanned surface a random gap or the noise lifts a vertex just over the
+// threshold; only regions that rise to twice it (caps over holes) are cut, so the surface
+// is not perforated: a 6 × 6 grid with one interior vertex at 1.8 × the threshold stays
+// whole, one at 2.5 × opens a hole there.
+void trim_cuts_only_regions_that_rise_far(void **) {
+    for (const double peak : {1.8, 2.5}) {
+        const gmpu::Mesh mesh = flat_grid(6, [peak](int i, int j) { return i == 3 && j == 3 ? peak : 0.2; });
+        const gmpu::Mesh trimmed = gmpu::trim_unsupported(mesh, 1.0);
+        const MeshCheck check = check_mesh(arrays_of(trimmed));
+        fprintf(stderr, "  a vertex at %.1f × the threshold: %zu of %zu triangles, %zu boundary edges\n", peak,
+                trimmed.triangle_count(), mesh.triangle_count(), check.boundary_edges);
+        if (peak < 2.0) {
+            assert_int_equal(trimmed.triangle_count(), mesh.triangle_count());
+            assert_int_equal(check.boundary_edges, 24);  // the square's own edge alone
+        } else {
+            assert_true(check.boundary_edges > 24);
+            assert_int_equal(check.components, 1);
+        }
+    }
+}
+
 // The same half-scanned sphere trimmed at 1.5 spacings: past the rim the data has ended,
 // so what the trim keeps stops within a spacing of it (the distance alone would keep
 // surface twice as far out). Measured against the scanned part itself: the sphere below
-// the rim, and the rim circle. (At 1.5 spacings this sparse random sample also loses a few
-// triangles inside the scanned part, where its gaps are widest.)
+// the rim, and the rim circle. What is left is a disc: the vertices a little over 1.5
+// spacings inside the scanned part, where this sparse random sample's gaps are widest, are
+// not cut (their regions never rise to twice the threshold), so the trim opens the hole
+// and nothing else.
 void trim_stops_at_the_rim(void **) {
     const double r = 1.0, rim = 0.6;
     std::vector<Vec3> pts;
@@ -305,6 +376,7 @@ void trim_stops_at_the_rim(void **) {
             farthest / spacing, ct.components, ct.component_reports[0].euler_characteristic);
     assert_true(farthest < 1.0 * spacing);
     assert_true(ct.component_reports[0].triangles >= 0.99 * double(t.triangles.size()));
+    assert_int_equal(ct.component_reports[0].euler_characteristic, 1);
     gmpu_mesh_destroy(trimmed);
     gmpu_mesh_destroy(m);
 }
@@ -581,6 +653,8 @@ int main(void) {
         cmocka_unit_test(simplify_error_bound_alone),
         cmocka_unit_test(simplify_bad_arguments),
         cmocka_unit_test(trim_opens_the_hole),
+        cmocka_unit_test(trim_clips_triangles_at_the_threshold),
+        cmocka_unit_test(trim_cuts_only_regions_that_rise_far),
         cmocka_unit_test(trim_stops_at_the_rim),
         cmocka_unit_test(trim_drops_slivers_apart),
         cmocka_unit_test(meshes_close_where_far_regions_meet_across_an_edge),

@@ -251,10 +251,11 @@ class Mesh:
         self._with_c_mesh(call)
         return Mesh._from_c(out[0])
 
-    def trim(self, threshold: float = 3.0) -> "Mesh":
-        """A copy without the triangles that have a vertex whose confidence is above
-        ``threshold`` sample spacings: the caps polygonize puts over a scan's holes go, leaving
-        boundaries. Only meshes made by polygonize carry a confidence; others raise
+    def trim(self, threshold: float = 1.5) -> "Mesh":
+        """A copy cut where the confidence passes ``threshold`` sample spacings, in the regions
+        that rise to twice it: the caps polygonize puts over a scan's holes go, leaving
+        boundaries (triangles across the cut are clipped). Only meshes made by polygonize
+        carry a confidence; others raise
         gmpu.InvalidArgumentError."""
         out = ffi.new("gmpu_mesh **")
 
