@@ -42,15 +42,21 @@ constexpr int kCoarseLevels = 1;
 // a ball of (trust / h)³ nodes, and the band's size would follow the gaps in the data
 // instead of the points and the grid. Beyond it the outer field answers.
 constexpr double kMaxReachSteps = 12.0;
+// The normals' field V reaches this many grid steps from each point (a cell diagonal
+// more), however far the band reaches: beyond it V is 0 and f only smooth, as in screened
+// Poisson's narrow splat. A wider V carries one sheet's normals across a thin wall onto the
+// other and, over a misoriented patch, makes f rise along the wrong normals over the
+// whole band instead of a few cells.
+constexpr double kNormalReachSteps = 3.0;
 // The outer field's grid step, in fine steps: coarse enough to cover the whole box at a
 // small cost, fine enough to keep a thin wall's two sides apart where it hands over.
 constexpr double kOuterSteps = 2.0;
 // Memory model, for GMPU_PARAM_MAX_MEMORY: per node of a touched block, the splat's sums
-// (weight, distance, normal) and its index; per unknown, the field, its six neighbours,
+// (weight, distance, the normals' weight and sum) and its index; per unknown, the field, its six neighbours,
 // its row's start and the solver's vectors; per point, its 8 trilinear weights and nodes,
 // its entries in the blocks' and the rows' lists (about 8 blocks, 8 corners) and its value
 // in the products.
-constexpr double kBytesPerSlotNode = 44, kBytesPerUnknown = 200, kBytesPerPoint = 180;
+constexpr double kBytesPerSlotNode = 52, kBytesPerUnknown = 200, kBytesPerPoint = 180;
 
 double weight(double d2, double r2) {
     const double t = 1.0 - d2 / r2;
@@ -184,7 +190,7 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
     // Splat: per node the weighted sums of the normals and of the point-to-plane distances.
     constexpr size_t BBB = size_t(B) * B * B;
     const size_t slot_nodes = size_t(slots) * BBB;
-    std::vector<double> wsum(slot_nodes, 0.0), distance(slot_nodes, 0.0);
+    std::vector<double> wsum(slot_nodes, 0.0), distance(slot_nodes, 0.0), normal_wsum(slot_nodes, 0.0);
     std::vector<Eigen::Vector3d> normal(slot_nodes, Eigen::Vector3d::Zero());
     auto slot_of = [&](int64_t x, int64_t y, int64_t z) {
         return size_t(block_slot_[size_t(x / B + blocks_[0] * (y / B + blocks_[1] * (z / B)))]) * BBB +
@@ -229,6 +235,8 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
             const Eigen::Vector3d p = points.point(i);
             const Eigen::Vector3d nrm(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);
             const double r = radius(i), r2 = r * r;
+            const double normal_reach = std::min(r, (kNormalReachSteps + std::sqrt(3.0)) * h_);
+            const double normal_r2 = normal_reach * normal_reach;
             for (int64_t z = lo[2]; z <= hi[2]; ++z)
                 for (int64_t y = lo[1]; y <= hi[1]; ++y)
                     for (int64_t x = lo[0]; x <= hi[0]; ++x) {
@@ -237,7 +245,9 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
                         if (w <= 0.0) continue;
                         const size_t s = slot * BBB + size_t(x - base[0] + B * (y - base[1] + B * (z - base[2])));
                         wsum[s] += w;
-                        normal[s] += w * nrm;
+                        const double wn = weight((q - p).squaredNorm(), normal_r2);
+                        normal_wsum[s] += wn;
+                        normal[s] += wn * nrm;
                         distance[s] += w * (p - q).dot(nrm);  // inside (behind the normal): positive
                     }
         }
@@ -270,7 +280,8 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
                 start[u] = coarse && coarse->value(q, c, nullptr) ? c : wsum[s] > 0.0 ? distance[s] / wsum[s] : 0.0;
                 // The average normal, shortened where neighbours disagree (between two sheets,
                 // across a thin part): there f need not rise at all.
-                field[size_t(u)] = wsum[s] > 0.0 ? Eigen::Vector3d(-normal[s] / wsum[s]) : Eigen::Vector3d::Zero();
+                field[size_t(u)] =
+                    normal_wsum[s] > 0.0 ? Eigen::Vector3d(-normal[s] / normal_wsum[s]) : Eigen::Vector3d::Zero();
                 const double length = field[size_t(u)].norm();
                 if (length > kAgreeing) field[size_t(u)] /= length;
             }
@@ -305,6 +316,7 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
     }
     std::vector<double>().swap(wsum);
     std::vector<double>().swap(distance);
+    std::vector<double>().swap(normal_wsum);
     std::vector<Eigen::Vector3d>().swap(normal);
     const double edge_weight = h_;  // Σ over edges of h·(Δf − h·V)² approximates ∫|∇f − V|²
     Eigen::VectorXd edge_diagonal = Eigen::VectorXd::Zero(unknowns);

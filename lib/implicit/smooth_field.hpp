@@ -7,7 +7,8 @@
 // least-squares problem spans the whole cloud, in the spirit of screened Poisson (Kazhdan &
 // Hoppe 2013): on a regular grid restricted to a band around the points, f minimises
 //     ∫ |∇f − V|²  +  α Σᵢ Aᵢ f(pᵢ)²
-// where V is the splatted field of the inward normals (unit where they agree) and the
+// where V is the splatted field of the inward normals (unit where they agree; within a few
+// grid steps of the points, 0 farther) and the
 // screening term pulls the zero set through the points, all weighted alike (Aᵢ: their mean
 // area), with α falling as the estimated noise grows; f is then shifted so that its mean
 // over the samples is 0. The gradient term couples every sample to its neighbours, so a point's noise
