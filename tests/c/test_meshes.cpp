@@ -344,8 +344,10 @@ void trim_cuts_only_regions_that_rise_far(void **) {
 }
 
 // The same half-scanned sphere trimmed at 1.5 spacings: past the rim the data has ended,
-// so what the trim keeps stops within a spacing of it (the distance alone would keep
-// surface twice as far out). Measured against the scanned part itself: the sphere below
+// so what the trim keeps stops close to it: its vertices past the rim are under 0.8
+// spacings off on average and none is 2 off (the distance alone keeps them 1.2–1.3 off on
+// average, the farthest 2.5–2.7, on 12 samples of this kind; the cut is at the threshold
+// itself, so a vertex where the gap's factor is small stays about 1.5 spacings out). Measured against the scanned part itself: the sphere below
 // the rim, and the rim circle. What is left is a disc: the vertices a little over 1.5
 // spacings inside the scanned part, where this sparse random sample's gaps are widest, are
 // not cut (their regions never rise to twice the threshold), so the trim opens the hole
@@ -369,12 +371,20 @@ void trim_stops_at_the_rim(void **) {
                                        : Vec3(0.8 * r, 0, rim * r);
         return (p - on_rim).norm();
     };
-    double farthest = 0;
-    for (const Vec3 &p : t.vertices) farthest = std::max(farthest, off_the_scan(p));
+    double farthest = 0, past_sum = 0;
+    size_t past = 0;
+    for (const Vec3 &p : t.vertices) {
+        farthest = std::max(farthest, off_the_scan(p));
+        if (p.normalized().z() > rim) past_sum += off_the_scan(p), ++past;
+    }
+    const double past_mean = past ? past_sum / double(past) : 0.0;
     const MeshCheck ct = check_mesh(t);
-    fprintf(stderr, "  trimmed at 1.5: farthest vertex %.2f spacings off the scanned part; %zu components, chi %ld\n",
-            farthest / spacing, ct.components, ct.component_reports[0].euler_characteristic);
-    assert_true(farthest < 1.0 * spacing);
+    fprintf(stderr,
+            "  trimmed at 1.5: farthest vertex %.2f spacings off the scanned part, %zu past the rim %.2f on average; "
+            "%zu components, chi %ld\n",
+            farthest / spacing, past, past_mean / spacing, ct.components, ct.component_reports[0].euler_characteristic);
+    assert_true(farthest < 2.0 * spacing);
+    assert_true(past_mean < 0.8 * spacing);
     assert_true(ct.component_reports[0].triangles >= 0.99 * double(t.triangles.size()));
     assert_int_equal(ct.component_reports[0].euler_characteristic, 1);
     gmpu_mesh_destroy(trimmed);
