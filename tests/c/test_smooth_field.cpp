@@ -143,24 +143,42 @@ void same_field_on_any_thread_count(void **) {
     assert_true(values[1] == values[0]);
 }
 
-// Where the zero set crosses the cap's axis, outward from the centre (in radii; 0 if
-// never).
-double axis_crossing(const SmoothField &field, const Cloud &c) {
+// Where the zero set crosses the ray from the centre along the unit `direction` (in radii;
+// 0 if never).
+double ray_crossing(const SmoothField &field, const Cloud &c, const Vector3d &direction) {
     const double h = field.spacing();
     double before = 0.0;
     for (double t = 0.0; t < 1.5 * c.radius; t += 0.25 * h) {
         double f;
-        if (!field.value(c.centre + Vector3d(0, 0, t), f, nullptr)) break;
+        if (!field.value(c.centre + t * direction, f, nullptr)) break;
         if (t > 0.0 && f <= 0.0) return (t - 0.25 * h * f / (f - before)) / c.radius;
         before = f;
     }
     return 0.0;
 }
 
+double axis_crossing(const SmoothField &field, const Cloud &c) { return ray_crossing(field, c, Vector3d(0, 0, 1)); }
+
+// How far `field`'s zero set lies inward of `reference`'s over the cap, on average over
+// rays spread across it (in radii): one ray's crossing moves with the noise of the few
+// points around it.
+double mean_dent(const SmoothField &field, const SmoothField &reference, const Cloud &c) {
+    double sum = 0.0;
+    int rays = 0;
+    for (double z : {0.96, 0.975, 0.99, 1.0})
+        for (int k = 0; k < (z < 1.0 ? 8 : 1); ++k) {
+            const double around = std::sqrt(1.0 - z * z), angle = 2.0 * M_PI * k / 8.0;
+            const Vector3d d(around * std::cos(angle), around * std::sin(angle), z);
+            sum += ray_crossing(reference, c, d) - ray_crossing(field, c, d);
+            ++rays;
+        }
+    return sum / rays;
+}
+
 // V reaches a few grid steps from the points, not their whole trust radius: the cap's
 // misoriented normals then make f rise outward over a few cells only, and the zero set
 // stays within a small fraction of the noise of where the right normals put it (reaching
-// the trust radius, the cap was dented by 6 % of the radius, about 2 σ).
+// the trust radius, the cap was dented by 6 % of the radius, about 2 σ, along its axis).
 void misoriented_cap_dents_little(void **) {
     const Cloud c = misoriented_cap_sphere();
     const double h = 1.0 / kResolution;
@@ -170,10 +188,10 @@ void misoriented_cap_dents_little(void **) {
     PointMeasures right = c.measures;
     right.blend_normals = c.true_normals;
     const SmoothField direct(c.points, right, h, 2.0 * h, 0.01, 1e10, workers, quiet);
-    const double at_field = axis_crossing(field, c), at_direct = axis_crossing(direct, c);
-    print_message("# cap axis crossing (radii): %.4f, from the right normals %.4f (noise %.4f)\n", at_field, at_direct,
+    const double dent = mean_dent(field, direct, c);
+    print_message("# the cap's zero set lies %.4f radii inward of the right normals' on average (noise %.4f)\n", dent,
                   c.sigma / c.radius);
-    assert_true(std::fabs(at_field - at_direct) < 0.25 * c.sigma / c.radius);
+    assert_true(dent < 0.3 * c.sigma / c.radius);
 }
 
 // Solved again from better normals (SmoothField::resolved), the outer field is solved again
