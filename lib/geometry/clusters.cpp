@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <numeric>
 
+#include "core/union_find.hpp"
+
 namespace gmpu {
 
 namespace {
@@ -21,18 +23,6 @@ constexpr size_t kMaxPieces = 512;
 // bounds no volume: it is not a cluster of its own.
 constexpr double kFlat = 1e-6;
 
-struct UnionFind {
-    std::vector<uint32_t> parent;
-    explicit UnionFind(size_t n) : parent(n) { std::iota(parent.begin(), parent.end(), 0u); }
-    uint32_t find(uint32_t a) {
-        while (parent[a] != a) a = parent[a] = parent[parent[a]];
-        return a;
-    }
-    void join(uint32_t a, uint32_t b) {
-        a = find(a), b = find(b);
-        if (a != b) parent[std::max(a, b)] = std::min(a, b);
-    }
-};
 
 struct Box {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};

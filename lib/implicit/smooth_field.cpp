@@ -52,8 +52,8 @@ constexpr double kNormalReachSteps = 3.0;
 // small cost, fine enough to keep a thin wall's two sides apart where it hands over.
 constexpr double kOuterSteps = 2.0;
 // Memory model, for GMPU_PARAM_MAX_MEMORY: per node of a touched block, the splat's sums
-// (weight, distance, the normals' weight and sum) and its index; per unknown, the field, its six neighbours,
-// its row's start and the solver's vectors; per point, its 8 trilinear weights and nodes,
+// (weight, distance, the normals' weight and sum) and its index; per unknown, the field,
+// its six neighbours, its row's start and the solver's vectors; per point, its 8 trilinear weights and nodes,
 // its entries in the blocks' and the rows' lists (about 8 blocks, 8 corners) and its value
 // in the products.
 constexpr double kBytesPerSlotNode = 52, kBytesPerUnknown = 200, kBytesPerPoint = 180;
@@ -241,11 +241,11 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
                 for (int64_t y = lo[1]; y <= hi[1]; ++y)
                     for (int64_t x = lo[0]; x <= hi[0]; ++x) {
                         const Eigen::Vector3d q = origin_ + h_ * Eigen::Vector3d(double(x), double(y), double(z));
-                        const double w = weight((q - p).squaredNorm(), r2);
+                        const double d2 = (q - p).squaredNorm(), w = weight(d2, r2);
                         if (w <= 0.0) continue;
                         const size_t s = slot * BBB + size_t(x - base[0] + B * (y - base[1] + B * (z - base[2])));
                         wsum[s] += w;
-                        const double wn = weight((q - p).squaredNorm(), normal_r2);
+                        const double wn = weight(d2, normal_r2);
                         normal_wsum[s] += wn;
                         normal[s] += wn * nrm;
                         distance[s] += w * (p - q).dot(nrm);  // inside (behind the normal): positive

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/parallel.hpp"
+#include "core/union_find.hpp"
 
 namespace gmpu {
 
@@ -109,14 +110,10 @@ constexpr double kSeedFactor = 2.0;
 // Per triangle of `triangles` (3 vertex indices each, vertex_count vertices): whether it
 // lies in a piece (triangles joined by shared vertices) of at least kMinPieceTriangles.
 std::vector<bool> in_real_pieces(const std::vector<uint32_t> &triangles, size_t vertex_count) {
-    std::vector<uint32_t> parent(vertex_count);
-    for (size_t v = 0; v < vertex_count; ++v) parent[v] = uint32_t(v);
-    auto root = [&](uint32_t v) {
-        while (parent[v] != v) v = parent[v] = parent[parent[v]];
-        return v;
-    };
+    UnionFind pieces(vertex_count);
     for (size_t t = 0; t < triangles.size(); t += 3)
-        for (int k = 1; k < 3; ++k) parent[root(triangles[t + size_t(k)])] = root(triangles[t]);
+        for (int k = 1; k < 3; ++k) pieces.join(triangles[t + size_t(k)], triangles[t]);
+    auto root = [&](uint32_t v) { return pieces.find(v); };
     std::vector<size_t> piece_triangles(vertex_count, 0);
     for (size_t t = 0; t < triangles.size(); t += 3) ++piece_triangles[root(triangles[t])];
     const size_t count = triangles.size() / 3;
@@ -132,17 +129,13 @@ std::vector<bool> in_real_pieces(const std::vector<uint32_t> &triangles, size_t 
 // region (vertices over it, joined by edges) that reaches kSeedFactor × threshold somewhere.
 std::vector<bool> unsupported_regions(const Mesh &mesh, double threshold) {
     const size_t n = mesh.vertex_count();
-    std::vector<uint32_t> parent(n);
-    for (size_t v = 0; v < n; ++v) parent[v] = uint32_t(v);
-    auto root = [&](uint32_t v) {
-        while (parent[v] != v) v = parent[v] = parent[parent[v]];
-        return v;
-    };
+    UnionFind regions(n);
+    auto root = [&](uint32_t v) { return regions.find(v); };
     auto over = [&](uint32_t v) { return !(mesh.confidence[v] <= threshold); };
     for (size_t t = 0; t < mesh.triangles.size(); t += 3)
         for (int k = 0; k < 3; ++k) {
             const uint32_t a = mesh.triangles[t + size_t(k)], b = mesh.triangles[t + size_t(k + 1) % 3];
-            if (over(a) && over(b)) parent[root(a)] = root(b);
+            if (over(a) && over(b)) regions.join(a, b);
         }
     std::vector<bool> seeded(n, false), away(n, false);
     for (size_t v = 0; v < n; ++v)

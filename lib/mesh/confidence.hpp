@@ -22,7 +22,9 @@ void compute_confidence(Mesh &mesh, const PointSet &points, const PointMeasures 
 
 // Cuts the mesh where its confidence, linear along each edge, passes `threshold`, keeping
 // the supported side (triangles across the cut are clipped, not dropped, so the boundary
-// follows the threshold however coarse the triangles), then removes the pieces of fewer
+// follows the threshold however coarse the triangles); only regions over the threshold
+// that rise to twice it somewhere are cut (caps over holes; a few vertices just over it
+// inside the scanned surface stay, unperforated). Then it removes the pieces of fewer
 // than 8 triangles left apart (slivers of a cap that passed within the threshold of the
 // data; kept if they are half the mesh), and the vertices left unused: the caps over holes
 // go, leaving boundaries where the data ends. The mesh must carry a confidence.

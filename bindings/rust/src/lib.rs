@@ -1039,8 +1039,9 @@ impl Mesh {
 
     /// A copy cut where the confidence passes `threshold` sample spacings, in the regions
     /// that rise to twice it (1.5 is a good start): the caps over a scan's holes go, leaving
-    /// boundaries (triangles across the cut are clipped). Fails with [`Status::InvalidArgument`] for a mesh without
-    /// confidence (made by [`Mesh::new`]) or a threshold that is not finite and positive.
+    /// boundaries (triangles across the cut are clipped). Fails with
+    /// [`Status::InvalidArgument`] for a mesh without confidence (made by [`Mesh::new`]) or a
+    /// threshold that is not finite and positive.
     pub fn trim(&self, threshold: f64) -> Result<Mesh> {
         let mut raw = ptr::null_mut();
         // SAFETY: valid handle and out pointer.
