@@ -4,35 +4,29 @@
 #include <numeric>
 
 #include "core/resize_reporting.hpp"
+#include "core/union_find.hpp"
 
 namespace gmpu {
 
 namespace {
 constexpr size_t kTickEvery = 4096;  // items between progress ticks: well under a millisecond
-
-uint32_t find(std::vector<uint32_t> &parent, uint32_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-}
 }  // namespace
 
 uint32_t vertex_components(const Mesh &mesh, std::vector<uint32_t> &component, Progress &progress) {
     const size_t n = mesh.vertex_count();
-    std::vector<uint32_t> parent;
-    assign_reporting(parent, n, progress);
-    std::iota(parent.begin(), parent.end(), 0u);
+    // Sized here, not by the constructor, so that a large mesh's allocation is reported.
+    UnionFind pieces(0);
+    assign_reporting(pieces.parent, n, progress);
+    std::iota(pieces.parent.begin(), pieces.parent.end(), 0u);
     for (size_t t = 0; t < mesh.triangles.size(); t += 3) {
         if (t % (3 * kTickEvery) == 0) progress.tick();
-        for (int e = 1; e < 3; ++e) {
-            uint32_t a = find(parent, mesh.triangles[t]), b = find(parent, mesh.triangles[t + e]);
-            if (a != b) parent[std::max(a, b)] = std::min(a, b);
-        }
+        for (int e = 1; e < 3; ++e) pieces.join(mesh.triangles[t], mesh.triangles[t + e]);
     }
     assign_reporting(component, n, progress, UINT32_MAX);
     uint32_t count = 0;
     for (size_t v = 0; v < n; ++v) {
         if (v % kTickEvery == 0) progress.tick();
-        uint32_t r = find(parent, uint32_t(v));
+        const uint32_t r = pieces.find(uint32_t(v));
         if (component[r] == UINT32_MAX) component[r] = count++;
         component[v] = component[r];
     }

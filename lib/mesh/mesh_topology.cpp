@@ -2,17 +2,13 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <numeric>
 #include <vector>
+
+#include "core/union_find.hpp"
 
 namespace gmpu {
 
 namespace {
-
-uint32_t find(std::vector<uint32_t> &parent, uint32_t x) {
-    while (parent[x] != x) x = parent[x] = parent[parent[x]];
-    return x;
-}
 
 // The directed edges of the triangles, grouped by their first vertex: a vertex's outgoing
 // edges are few (about 6), so a lookup scans its group, and grouping is O(n) where one
@@ -70,8 +66,7 @@ MeshTopology mesh_topology(const Mesh &mesh, std::vector<uint32_t> *culprits) {
     MeshTopology t;
     const size_t n = mesh.vertex_count();
     const std::vector<uint32_t> &tri = mesh.triangles;
-    std::vector<uint32_t> parent(n);
-    std::iota(parent.begin(), parent.end(), 0u);
+    UnionFind pieces(n);
     std::vector<uint32_t> incident(n, 0);
     size_t faces = 0;
     for (size_t f = 0; f < tri.size() / 3; ++f) {
@@ -82,10 +77,7 @@ MeshTopology mesh_topology(const Mesh &mesh, std::vector<uint32_t> *culprits) {
         }
         ++faces;
         for (uint32_t v : {a, b, c}) ++incident[v];
-        for (uint32_t v : {b, c}) {
-            uint32_t ra = find(parent, a), rv = find(parent, v);
-            if (ra != rv) parent[std::max(ra, rv)] = std::min(ra, rv);
-        }
+        for (uint32_t v : {b, c}) pieces.join(a, v);
     }
     const OutgoingEdges edges(n, tri);
     // A triangle duplicates an earlier one on the same three vertices: that one holds the
@@ -172,7 +164,7 @@ MeshTopology mesh_topology(const Mesh &mesh, std::vector<uint32_t> *culprits) {
     for (uint32_t v = 0; v < n; ++v) {
         if (incident[v] == 0) continue;
         ++used;
-        const uint32_t r = find(parent, v);
+        const uint32_t r = pieces.find(v);
         if (!root_seen[r]) root_seen[r] = 1, ++t.components;
     }
     t.euler_characteristic = long(used) - long(undirected) + long(faces);
