@@ -11,6 +11,7 @@
 #include "implicit/point_measures.hpp"
 #include "implicit/smooth_field.hpp"
 #include "pipeline/smooth_normals.hpp"
+#include "random_vectors.hpp"
 
 #include <setjmp.h>
 #include <stdarg.h>
@@ -19,6 +20,8 @@
 extern "C" {
 #include <cmocka.h>
 }
+
+using gmpu_test::draw_vector;
 
 using Eigen::Vector3d;
 using namespace gmpu;
@@ -36,7 +39,7 @@ PointSet noisy_sphere(double sigma, std::vector<float> &truth) {
     std::vector<double> xyz;
     truth.clear();
     for (size_t i = 0; i < kPoints; ++i) {
-        Vector3d d(gauss(rng), gauss(rng), gauss(rng));
+        Vector3d d = draw_vector(gauss, rng);
         d.normalize();
         const Vector3d p = (kRadius + sigma * gauss(rng)) * d;
         for (int k = 0; k < 3; ++k) {

@@ -17,6 +17,7 @@
 #include "primitive_meshes.hpp"
 #include "sampling.hpp"
 #include "triangle_distance.hpp"
+#include "random_vectors.hpp"
 
 // cmocka last: its macros (fail, ...) clash with names in the C++ headers. Its header
 // has no extern "C" of its own.
@@ -27,6 +28,8 @@
 extern "C" {
 #include <cmocka.h>
 }
+
+using gmpu_test::draw_vector;
 
 using namespace gmpu::testing;
 
@@ -91,8 +94,8 @@ void closest_point_never_beaten_by_dense_sampling(void **) {
     std::uniform_real_distribution<double> u(-1, 1);
     constexpr int kGrid = 60;
     for (int trial = 0; trial < 200; ++trial) {
-        const Vec3 a(u(rng), u(rng), u(rng)), b(u(rng), u(rng), u(rng)), c(u(rng), u(rng), u(rng));
-        const Vec3 p = 2 * Vec3(u(rng), u(rng), u(rng));
+        const Vec3 a = draw_vector(u, rng), b = draw_vector(u, rng), c = draw_vector(u, rng);
+        const Vec3 p = 2 * draw_vector(u, rng);
         const double exact = point_triangle_distance(p, a, b, c);
         double sampled = std::numeric_limits<double>::infinity();
         for (int i = 0; i <= kGrid; ++i)
@@ -112,13 +115,13 @@ void tree_matches_brute_force(void **) {
     TriangleMesh mesh = merged(icosphere(3), torus_mesh(1.5, 0.4, 40, 16, Vec3(0.5, 0, 0)));
     std::mt19937_64 rng(3);
     std::normal_distribution<double> jitter(0, 0.02);
-    for (Vec3 &v : mesh.vertices) v += Vec3(jitter(rng), jitter(rng), jitter(rng));
+    for (Vec3 &v : mesh.vertices) v += draw_vector(jitter, rng);
     const AabbTree tree(mesh);
     assert_int_equal(tree.size(), mesh.triangles.size());
 
     std::uniform_real_distribution<double> u(-3, 3);
     std::vector<Vec3> queries;
-    for (int i = 0; i < 3000; ++i) queries.emplace_back(u(rng), u(rng), u(rng));
+    for (int i = 0; i < 3000; ++i) queries.push_back(draw_vector(u, rng));
     const std::vector<AabbTree::Nearest> hits = tree.nearest_all(queries, 2);
     for (size_t i = 0; i < queries.size(); ++i) {
         double brute = std::numeric_limits<double>::infinity();
@@ -156,7 +159,7 @@ void tree_answers_100k_queries_on_100k_triangles_fast(void **) {
     std::uniform_real_distribution<double> u(-1.5, 1.5);
     // Mostly near the surface, as the metrics query; every 20th anywhere in the box (a
     // point far from a curved surface has many near-equidistant triangles: the slow case).
-    for (size_t i = 0; i < queries.size(); i += 20) queries[i] = Vec3(u(rng), u(rng), u(rng));
+    for (size_t i = 0; i < queries.size(); i += 20) queries[i] = draw_vector(u, rng);
     const auto start = std::chrono::steady_clock::now();
     const AabbTree tree(mesh);
     const std::vector<AabbTree::Nearest> hits = tree.nearest_all(queries, 1);

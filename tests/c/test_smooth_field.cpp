@@ -15,6 +15,7 @@
 #include "geometry/point_set.hpp"
 #include "implicit/point_measures.hpp"
 #include "implicit/smooth_field.hpp"
+#include "random_vectors.hpp"
 
 #include <setjmp.h>
 #include <stdarg.h>
@@ -23,6 +24,8 @@
 extern "C" {
 #include <cmocka.h>
 }
+
+using gmpu_test::draw_vector;
 
 using Eigen::Vector3d;
 using namespace gmpu;
@@ -55,7 +58,7 @@ Cloud misoriented_cap_sphere(double misoriented = kMisoriented) {
     std::vector<Vector3d> outward;
     Cloud c;
     for (size_t i = 0; i < kPoints; ++i) {
-        Vector3d d(gauss(rng), gauss(rng), gauss(rng));
+        Vector3d d = draw_vector(gauss, rng);
         d.normalize();
         const Vector3d p = d * (1.0 + sigma * gauss(rng));
         xyz.insert(xyz.end(), {p.x(), p.y(), p.z()});
@@ -231,7 +234,7 @@ void thin_wall_sheets_at_noise(void **) {
     std::vector<double> xyz;
     PointMeasures measures;
     for (size_t i = 0; i < kWallPoints; ++i) {
-        Vector3d d(gauss(rng), gauss(rng), gauss(rng));
+        Vector3d d = draw_vector(gauss, rng);
         d.normalize();
         const bool on_inner = std::uniform_real_distribution<double>()(rng) < inner_share;
         const Vector3d p = d * ((on_inner ? inner : 1.0) + sigma * gauss(rng));
@@ -258,7 +261,7 @@ void thin_wall_sheets_at_noise(void **) {
     double outer_error = 0.0, inner_error = 0.0;
     size_t rays = 0, two_sheets = 0;
     for (int k = 0; k < 200; ++k) {
-        Vector3d d(gauss(rng), gauss(rng), gauss(rng));
+        Vector3d d = draw_vector(gauss, rng);
         d.normalize();
         auto f_at = [&](double r) {
             double f = 0.0;

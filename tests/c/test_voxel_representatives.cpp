@@ -11,6 +11,7 @@
 
 #include "geometry/point_set.hpp"
 #include "mesh/point_buckets.hpp"
+#include "random_vectors.hpp"
 
 #include <setjmp.h>
 #include <stdarg.h>
@@ -19,6 +20,8 @@
 extern "C" {
 #include <cmocka.h>
 }
+
+using gmpu_test::draw_vector;
 
 using namespace gmpu;
 
@@ -54,7 +57,7 @@ PointSet cloud(size_t n, unsigned seed) {
     std::vector<double> xyz;
     for (size_t i = 0; i < n; ++i) {
         // A sphere's surface, with every tenth point repeating an earlier one.
-        Eigen::Vector3d p(u(rng), u(rng), u(rng));
+        Eigen::Vector3d p = draw_vector(u, rng);
         if (i % 10 == 9) p = Eigen::Vector3d(xyz[3 * (i / 2)], xyz[3 * (i / 2) + 1], xyz[3 * (i / 2) + 2]);
         else p.normalize();
         xyz.insert(xyz.end(), {p[0], p[1], p[2]});

@@ -1,8 +1,11 @@
 #include "analytic_shapes.hpp"
+#include "random_vectors.hpp"
 
 #include <cmath>
 #include <random>
 #include <stdexcept>
+
+using gmpu_test::draw_vector;
 
 namespace gmpu::testing {
 
@@ -13,7 +16,7 @@ constexpr double kPi = 3.14159265358979323846;
 Vec3 random_direction(std::mt19937_64 &rng) {
     std::normal_distribution<double> gauss;
     for (;;) {  // an isotropic Gaussian, normalised, is uniform on the sphere
-        const Vec3 v(gauss(rng), gauss(rng), gauss(rng));
+        const Vec3 v = draw_vector(gauss, rng);
         const double n = v.norm();
         if (n > 1e-12) return v / n;
     }
