@@ -44,12 +44,14 @@ void check_failure(gmpu_status st, std::initializer_list<gmpu_status> allowed, c
         finding("failure without a proper message", st);
 }
 
-// CPU seconds (every thread of the process) one input may take in the sanitizer build;
-// GMPU_FUZZ_CPU_BUDGET overrides it (a tighter budget finds the slowest inputs faster).
+// CPU seconds (every thread of the process) one input may take in the sanitizer build:
+// twice what the slowest seed (a smooth solve up to the memory budget) takes there, so that
+// a seed near the limit does not fail one run in a few. GMPU_FUZZ_CPU_BUDGET overrides it
+// (a tighter budget finds the slowest inputs faster).
 double cpu_budget_seconds() {
     static const double budget = [] {
         const char *text = std::getenv("GMPU_FUZZ_CPU_BUDGET");
-        return text ? std::atof(text) : 60.0;
+        return text ? std::atof(text) : 120.0;
     }();
     return budget;
 }
