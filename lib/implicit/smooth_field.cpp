@@ -76,6 +76,16 @@ SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, 
                          double noise, double max_memory, Workers &workers, Progress &progress) {
     if (points.size() == 0) return;
     max_reach_ = kMaxReachSteps * spacing;
+    {
+        // The fine band takes more memory than the coarser bands: laid out first, its memory
+        // check fails a cloud too scattered for the budget before the outer field and the
+        // coarser bands are solved for nothing.
+        SmoothField fine;
+        fine.h_ = spacing;
+        fine.max_reach_ = max_reach_;
+        Progress layout_progress = progress.slice(0.0, 0.0);
+        fine.lay_out(points, measures, min_trust, false, max_memory, layout_progress);
+    }
     // The outer field: the same problem on a coarser grid over the whole box, solved first.
     auto outer = std::make_shared<SmoothField>();
     outer->h_ = kOuterSteps * spacing;
@@ -135,16 +145,23 @@ SmoothField SmoothField::resolved(const PointSet &points, const PointMeasures &m
     return next;
 }
 
-double SmoothField::solve(const PointSet &points, const PointMeasures &measures, const std::vector<float> &normals,
-                          double min_trust, double noise, double max_memory, const SmoothField *coarse,
-                          const SmoothField *boundary, bool whole_box, int iterations, Workers &workers,
-                          Progress &progress) {
+double SmoothField::splat_radius(const PointMeasures &measures, size_t i, double min_trust) const {
+    return std::min(std::max(double(measures.trust_radius[i]), min_trust), max_reach_) + std::sqrt(3.0) * h_;
+}
+
+void SmoothField::box_of(const Eigen::Vector3d &point, double r, int64_t lo[3], int64_t hi[3]) const {
+    const Eigen::Vector3d p = point - origin_;
+    for (int d = 0; d < 3; ++d) {
+        lo[d] = std::max<int64_t>(0, int64_t(std::ceil((p[d] - r) / h_)));
+        hi[d] = std::min<int64_t>(nodes_[d] - 1, int64_t(std::floor((p[d] + r) / h_)));
+    }
+}
+
+int32_t SmoothField::lay_out(const PointSet &points, const PointMeasures &measures, double min_trust, bool whole_box,
+                             double max_memory, Progress &progress) {
     const size_t n = points.size();
-    auto radius = [&](size_t i) {
-        return std::min(std::max(double(measures.trust_radius[i]), min_trust), max_reach_) + std::sqrt(3.0) * h_;
-    };
     double widest = 0.0;
-    for (size_t i = 0; i < n; ++i) widest = std::max(widest, radius(i));
+    for (size_t i = 0; i < n; ++i) widest = std::max(widest, splat_radius(measures, i, min_trust));
     origin_ = points.box_min() - Eigen::Vector3d::Constant(widest + 2.0 * h_);
     for (int d = 0; d < 3; ++d) {
         nodes_[d] = int64_t(std::ceil((points.box_max()[d] - origin_[d] + widest + 2.0 * h_) / h_)) + 1;
@@ -158,22 +175,13 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
         throw Error(GMPU_ERROR_LIMIT_EXCEEDED, std::string(what) + " takes at most 536,870,911 points");
     block_slot_.assign(size_t(blocks_[0] * blocks_[1] * blocks_[2]), -1);
 
-    // The nodes within each point's radius, a box of them per point.
-    auto node_box = [&](size_t i, int64_t lo[3], int64_t hi[3]) {
-        const Eigen::Vector3d p = points.point(i) - origin_;
-        const double r = radius(i);
-        for (int d = 0; d < 3; ++d) {
-            lo[d] = std::max<int64_t>(0, int64_t(std::ceil((p[d] - r) / h_)));
-            hi[d] = std::min<int64_t>(nodes_[d] - 1, int64_t(std::floor((p[d] + r) / h_)));
-        }
-    };
     int32_t slots = 0;
     if (whole_box)
         for (int32_t &s : block_slot_) s = slots++;
     for (size_t i = 0; i < n && !whole_box; ++i) {
         if (i % 1024 == 0) progress.poll(0.05 * double(i) / double(n));
         int64_t lo[3], hi[3];
-        node_box(i, lo, hi);
+        box_of(points.point(i), splat_radius(measures, i, min_trust), lo, hi);
         for (int64_t z = lo[2] / B; z <= hi[2] / B; ++z)
             for (int64_t y = lo[1] / B; y <= hi[1] / B; ++y)
                 for (int64_t x = lo[0] / B; x <= hi[0] / B; ++x) {
@@ -181,11 +189,21 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
                     if (s < 0) s = slots++;
                 }
     }
-
     // Every node of a touched block might be an unknown: an upper estimate, before the
     // big allocations.
     const double block_nodes = double(slots) * B * B * B;
     check_memory(block_nodes * (kBytesPerSlotNode + kBytesPerUnknown) + double(n) * kBytesPerPoint, max_memory, what);
+    return slots;
+}
+
+double SmoothField::solve(const PointSet &points, const PointMeasures &measures, const std::vector<float> &normals,
+                          double min_trust, double noise, double max_memory, const SmoothField *coarse,
+                          const SmoothField *boundary, bool whole_box, int iterations, Workers &workers,
+                          Progress &progress) {
+    const size_t n = points.size();
+    const int32_t slots = lay_out(points, measures, min_trust, whole_box, max_memory, progress);
+    auto radius = [&](size_t i) { return splat_radius(measures, i, min_trust); };
+    auto node_box = [&](size_t i, int64_t lo[3], int64_t hi[3]) { box_of(points.point(i), radius(i), lo, hi); };
 
     // Splat: per node the weighted sums of the normals and of the point-to-plane distances.
     constexpr size_t BBB = size_t(B) * B * B;

@@ -78,6 +78,14 @@ private:
     double solve(const PointSet &points, const PointMeasures &measures, const std::vector<float> &normals,
                  double min_trust, double noise, double max_memory, const SmoothField *coarse,
                  const SmoothField *boundary, bool whole_box, int iterations, Workers &workers, Progress &progress);
+    // The grid over the points' box and its blocks within a splat's reach of a point (every
+    // block when `whole_box`); checks the memory this level will take against `max_memory`
+    // (LIMIT_EXCEEDED). Returns the number of blocks laid out.
+    int32_t lay_out(const PointSet &points, const PointMeasures &measures, double min_trust, bool whole_box,
+                    double max_memory, Progress &progress);
+    double splat_radius(const PointMeasures &measures, size_t i, double min_trust) const;
+    // The grid nodes within `r` of `point`, as a box of node coordinates.
+    void box_of(const Eigen::Vector3d &point, double r, int64_t lo[3], int64_t hi[3]) const;
     // The band's own value (the fine grid only).
     bool band_value(const Eigen::Vector3d &x, double &f, Eigen::Vector3d *gradient) const;
     int32_t node(int64_t x, int64_t y, int64_t z) const;  // unknown index, -1 outside the band

@@ -7,10 +7,12 @@
 // width off the sphere. With the outer field over the whole box at the band's edge, the
 // cap's error relaxes into the space around it: outside the cap f turns negative within a
 // few cells, and the far outside is outside everywhere.
+#include <algorithm>
 #include <cmath>
 #include <random>
 #include <vector>
 
+#include "core/error.hpp"
 #include "core/progress.hpp"
 #include "geometry/point_set.hpp"
 #include "implicit/point_measures.hpp"
@@ -317,6 +319,52 @@ void band_stays_near_scattered_points(void **) {
     assert_true(double(field.unknowns()) <= bound);
 }
 
+// The largest progress fraction reported.
+int record_fraction(void *user, gmpu_stage, double fraction) {
+    double &most = *static_cast<double *>(user);
+    most = std::max(most, fraction);
+    return 0;
+}
+
+// A cloud whose fine band is over the memory budget fails before anything is solved: the
+// outer field and the coarse band fit the budget and were solved first (seconds under
+// the sanitizers for nothing), reporting their progress, and only the fine band's check
+// failed. Eight points far apart at h = 1/64: the outer field over the whole box and the
+// coarse band fit in 60 MB, the fine band (a ball of 12 steps round each point) needs
+// about 66 MB.
+void band_over_budget_fails_before_solving(void **) {
+    std::vector<double> xyz;
+    for (int k = 0; k < 8; ++k) xyz.insert(xyz.end(), {k & 1 ? 0.4 : -0.4, k & 2 ? 0.4 : -0.4, k & 4 ? 0.4 : -0.4});
+    const PointSet points = PointSet::from_array(xyz.data(), 8, 0, 1);
+    const Vector3d centre = 0.5 * (points.box_min() + points.box_max());
+    PointMeasures measures;
+    for (size_t i = 0; i < 8; ++i) {
+        const Vector3d out = (points.point(i) - centre).normalized();
+        for (int k = 0; k < 3; ++k) measures.blend_normals.push_back(float(out[k]));
+        measures.trust_radius.push_back(0.6f);
+        measures.area.push_back(0.1f);
+    }
+    measures.widest_trust = 0.6;
+    measures.normals = measures.blend_normals;
+    const double h = 1.0 / 64, budget = 60e6;
+    double most = 0.0;
+    Progress watched(record_fraction, &most, GMPU_STAGE_ORIENT);
+    Workers workers(2);
+    gmpu_status status = GMPU_OK;
+    try {
+        const SmoothField field(points, measures, h, 2.0 * h, 0.01, budget, workers, watched);
+    } catch (const Error &e) {
+        status = e.status();
+        print_message("# %s\n", e.what());
+    }
+    print_message("# most progress reported before the failure: %.3f\n", most);
+    assert_int_equal(status, GMPU_ERROR_LIMIT_EXCEEDED);
+    assert_true(most == 0.0);
+    // With room for the fine band, the same field is solved.
+    const SmoothField field(points, measures, h, 2.0 * h, 0.01, 4.0 * budget, workers, watched);
+    assert_false(field.empty());
+}
+
 }  // namespace
 
 int main() {
@@ -325,6 +373,7 @@ int main() {
         cmocka_unit_test(misoriented_cap_dents_little),
         cmocka_unit_test(resolved_follows_the_new_normals),
         cmocka_unit_test(band_stays_near_scattered_points),
+        cmocka_unit_test(band_over_budget_fails_before_solving),
         cmocka_unit_test(thin_wall_sheets_at_noise),
         cmocka_unit_test(same_field_on_any_thread_count),
     };
