@@ -45,9 +45,10 @@ void check_failure(gmpu_status st, std::initializer_list<gmpu_status> allowed, c
 }
 
 // CPU seconds (every thread of the process) one input may take in the sanitizer build:
-// twice what the slowest seed (a smooth solve up to the memory budget) takes there, so that
-// a seed near the limit does not fail one run in a few. GMPU_FUZZ_CPU_BUDGET overrides it
-// (a tighter budget finds the slowest inputs faster).
+// many times what the slowest seed (a full smooth solve) takes there, since inside the
+// fuzzing loop (coverage tracing, allocation hooks) an input costs more than run alone,
+// and only a runaway input should be a finding. GMPU_FUZZ_CPU_BUDGET overrides it (a
+// tighter budget finds the slowest inputs faster).
 double cpu_budget_seconds() {
     static const double budget = [] {
         const char *text = std::getenv("GMPU_FUZZ_CPU_BUDGET");
