@@ -151,7 +151,8 @@ bool keeps_topology(const MeshTopology &before, const MeshTopology &after) {
 }
 
 PatchDecimation decimate_patch(const std::vector<float> &positions, std::vector<uint32_t> &triangles,
-                               size_t target_triangles, double budget, const std::vector<char> *fixed) {
+                               size_t target_triangles, double budget, const std::vector<char> *fixed,
+                               const BrokenRound *first) {
     PatchDecimation result;
     const size_t n = positions.size() / 3;
     if (triangles.empty() || n == 0) return result;
@@ -169,14 +170,18 @@ PatchDecimation decimate_patch(const std::vector<float> &positions, std::vector<
     size_t ask = target_triangles;  // of this round: more than the target after a failure
     while (triangles.size() / 3 > target_triangles && failures <= kRetries && result.spent <= budget) {
         float round_error = 0.0f;
+        const bool known = first && result.rounds == 0;
         ++result.rounds;
         result.work += triangles.size() / 3;
-        const size_t got = collapse_round(triangles, positions, locked, ask, (budget - result.spent) / scale, next,
-                                          round_error);
+        const size_t got = known ? first->triangles.size() / 3
+                                 : collapse_round(triangles, positions, locked, ask, (budget - result.spent) / scale,
+                                                  next, round_error);
+        if (known) next = first->triangles;
         if (3 * got >= triangles.size()) break;  // the error bound (or the locks) allow no collapse
         probe.triangles = next;
         culprits.clear();
-        if (keeps_topology(before, mesh_topology(probe, &culprits))) {
+        if (known) culprits = first->culprits;
+        if (!known && keeps_topology(before, mesh_topology(probe, &culprits))) {
             triangles.swap(next);
             result.spent += double(round_error) * scale;
             failures = 0;
@@ -224,7 +229,10 @@ Mesh simplify_mesh(const Mesh &mesh, size_t target_triangles, double target_erro
         std::vector<float> positions(base.vertices.begin(), base.vertices.end());
         // Large meshes: most of the reduction patch by patch, each with its own retries,
         // then one pass over the whole (smaller) mesh to reach the target across the seams.
-        bool chunked = false;
+        bool chunked = false, trial_broke = false;
+        // The first round over the whole mesh: when it breaks the topology, it is also the
+        // first round of every pass below that starts from the whole mesh.
+        BrokenRound trial;
         if (current.size() / 3 > 2 * kChunkTriangles && target_triangles * 2 < current.size() / 3) {
             // One round over the whole mesh first. When it keeps the topology, or stops at the
             // error bound short of the count (where chunks, each held to its share of the
@@ -232,34 +240,40 @@ Mesh simplify_mesh(const Mesh &mesh, size_t target_triangles, double target_erro
             // reaches the count but breaks the topology, the chunks redo it, each retrying
             // alone.
             const double scale = double(meshopt_simplifyScale(positions.data(), base.vertex_count(), 3 * sizeof(float)));
-            std::vector<uint32_t> trial;
             float round_error = 0.0f;
             const size_t got = scale > 0 ? collapse_round(current, positions, std::vector<char>(base.vertex_count(), 0),
-                                                          target_triangles, budget / scale, trial, round_error)
+                                                          target_triangles, budget / scale, trial.triangles,
+                                                          round_error)
                                          : current.size() / 3;
             Mesh probe;  // mesh_topology reads the vertex count, not the positions
             probe.vertices.assign(base.vertices.size(), 0.0);
             probe.triangles = current;
             const MeshTopology before = mesh_topology(probe);
-            probe.triangles = trial;
-            if (keeps_topology(before, mesh_topology(probe))) {
-                current.swap(trial);
+            probe.triangles = trial.triangles;
+            if (scale > 0 && keeps_topology(before, mesh_topology(probe, &trial.culprits))) {
+                current.swap(trial.triangles);
                 spent = double(round_error) * scale;
-            } else if (got <= target_triangles) {
+            } else if (scale > 0) {
+                trial_broke = true;
+            }
+            if (trial_broke && got <= target_triangles) {
                 // Half the error bound: the other half is for the pass over the whole mesh,
                 // which collapses the seams the chunks had to keep.
-                const ChunkedDecimation chunks = decimate_in_chunks(positions, current, target_triangles, 0.5 * budget,
-                                                                    kChunkTriangles, workers, progress, &trial, &before);
+                const ChunkedDecimation chunks =
+                    decimate_in_chunks(positions, current, target_triangles, 0.5 * budget, kChunkTriangles, workers,
+                                       progress, &trial.triangles, &before);
                 if (chunks.kept) current = chunks.triangles, spent = chunks.spent, chunked = true;
             }
         }
-        spent += decimate_patch(positions, current, target_triangles, budget - spent).spent;
+        spent += decimate_patch(positions, current, target_triangles, budget - spent, nullptr,
+                                trial_broke && !chunked ? &trial : nullptr).spent;
         // Each chunk spends the error bound on its own share of the count, where the whole
         // mesh collapses wherever it is cheapest: the chunks may use up the bound short of
         // the count the whole mesh reaches. Then the whole mesh, from the start.
         if (chunked && target_triangles > 0 && current.size() / 3 > target_triangles) {
             std::vector<uint32_t> whole = base.triangles;
-            const double whole_spent = decimate_patch(positions, whole, target_triangles, budget).spent;
+            const double whole_spent =
+                decimate_patch(positions, whole, target_triangles, budget, nullptr, &trial).spent;
             if (whole.size() < current.size()) current.swap(whole), spent = whole_spent;
         }
     }

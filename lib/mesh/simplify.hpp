@@ -35,17 +35,26 @@ constexpr size_t kChunkTriangles = 16384;
 // What one patch's decimation did.
 struct PatchDecimation {
     double spent = 0.0;  // error bound used, in the positions' units
-    size_t rounds = 0;   // meshopt calls, the retried ones included
+    size_t rounds = 0;   // meshopt calls, the retried ones and a given first round included
     size_t retries = 0;  // rounds whose result broke the topology and were redone
     size_t work = 0;     // triangles handed to meshopt over all rounds
+};
+
+// A round of collapses already run on a patch, exactly as decimate_patch's first round
+// would run it, whose result broke the topology at `culprits` (mesh_topology's).
+struct BrokenRound {
+    std::vector<uint32_t> triangles;
+    std::vector<uint32_t> culprits;
 };
 
 // The rounds of collapses on one patch (`triangles` indexes `positions`, xyz floats), in
 // place: towards `target_triangles`, within `budget` (absolute), border vertices and those
 // `fixed` marks (per vertex, may be null) locked, every round checked by keeps_topology
-// against the patch as given.
+// against the patch as given. `first` (may be null): the first round's result, known
+// already, so it is not run again.
 PatchDecimation decimate_patch(const std::vector<float> &positions, std::vector<uint32_t> &triangles,
-                               size_t target_triangles, double budget, const std::vector<char> *fixed = nullptr);
+                               size_t target_triangles, double budget, const std::vector<char> *fixed = nullptr,
+                               const BrokenRound *first = nullptr);
 
 // `after` is the same surface type as `before` (MeshTopology::same_as) and has no more
 // defects of any kind: a patch cut out of a manifold mesh may be pinched at a border

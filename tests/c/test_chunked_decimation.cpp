@@ -1,7 +1,8 @@
 // Decimation of large meshes chunk by chunk (mesh/chunked_decimation.hpp): the vertices two
 // chunks share stay, so the chunks fit back together into the same closed surface, and a
 // chunk whose collapses break the topology is redone alone while the others keep their
-// single round.
+// single round. A whole mesh's first round, run already by simplify_mesh to choose between
+// chunks and the whole, is not run again by decimate_patch.
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -108,9 +109,44 @@ void failing_chunk_alone_is_retried(void **) {
     assert_int_equal(after.euler_characteristic, 0);
 }
 
+void given_first_round_is_not_rerun(void **) {
+    // A torus that decimates in one round that keeps the topology. Told that its first round
+    // already ran and broke the topology at one vertex, decimate_patch takes that round as
+    // its first (it does not run it again: run, it would have kept the topology), locks the
+    // vertex with its neighbours and redoes the round: the vertex stays.
+    std::vector<float> positions;
+    std::vector<uint32_t> triangles;
+    add_torus(positions, triangles, 0.0f, 1.0f, 0.4f, 200, 100);
+    const size_t count = triangles.size() / 3;
+    std::vector<uint32_t> plain = triangles;
+    const PatchDecimation alone = decimate_patch(positions, plain, count / 10, 1.0);
+    assert_int_equal(alone.rounds, 1);
+    assert_int_equal(alone.retries, 0);
+
+    const uint32_t culprit = 5050;
+    bool collapsed = true;
+    for (uint32_t v : plain) collapsed = collapsed && v != culprit;
+    assert_true(collapsed);  // without the lock, the round collapses it away
+    BrokenRound first;
+    first.triangles.assign(triangles.begin(), triangles.begin() + 3 * long(count / 2));
+    first.culprits = {culprit};
+    const PatchDecimation redone = decimate_patch(positions, triangles, count / 10, 1.0, nullptr, &first);
+    assert_int_equal(redone.rounds, 2);
+    assert_int_equal(redone.retries, 1);
+    bool kept = false;
+    for (uint32_t v : triangles) kept = kept || v == culprit;
+    assert_true(kept);
+    assert_true(triangles.size() / 3 <= count / 10 + count / 100);
+    const MeshTopology after = topology(positions.size() / 3, triangles);
+    assert_true(after.closed_manifold());
+    assert_int_equal(after.euler_characteristic, 0);
+}
+
 }  // namespace
 
 int main() {
-    const struct CMUnitTest tests[] = {cmocka_unit_test(chunk_borders_stay), cmocka_unit_test(failing_chunk_alone_is_retried)};
+    const struct CMUnitTest tests[] = {cmocka_unit_test(chunk_borders_stay),
+                                       cmocka_unit_test(failing_chunk_alone_is_retried),
+                                       cmocka_unit_test(given_first_round_is_not_rerun)};
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
