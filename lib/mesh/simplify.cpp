@@ -143,6 +143,67 @@ size_t collapse_round(const std::vector<uint32_t> &triangles, const std::vector<
 
 }  // namespace
 
+double remove_fins(std::vector<uint32_t> &triangles, const std::vector<float> &positions, double reach) {
+    const size_t n = positions.size() / 3;
+    std::vector<uint32_t> uses(n, 0);
+    for (uint32_t v : triangles) ++uses[v];
+    std::vector<uint32_t> first(n, UINT32_MAX);  // a two-triangle vertex's first triangle
+    std::vector<char> drop(triangles.size() / 3, 0);
+    double highest = -1.0;
+    auto at = [&](uint32_t v) { return Eigen::Vector3d(positions[3 * v], positions[3 * v + 1], positions[3 * v + 2]); };
+    for (uint32_t t = 0; t < uint32_t(triangles.size() / 3); ++t)
+        for (int k = 0; k < 3; ++k) {
+            const uint32_t v = triangles[3 * t + k];
+            if (uses[v] != 2) continue;
+            if (first[v] == UINT32_MAX) {
+                first[v] = t;
+                continue;
+            }
+            // v's two triangles: (v, a, b) and, for a fin, (v, b, a).
+            const uint32_t s = first[v];
+            int j = 0;
+            while (triangles[3 * s + j] != v) ++j;
+            const uint32_t a = triangles[3 * s + (j + 1) % 3], b = triangles[3 * s + (j + 2) % 3];
+            if (triangles[3 * t + (k + 1) % 3] != b || triangles[3 * t + (k + 2) % 3] != a) continue;
+            const Eigen::Vector3d p = at(v), e0 = at(a), e1 = at(b), d = e1 - e0;
+            const double along = d.squaredNorm() > 0.0 ? std::clamp((p - e0).dot(d) / d.squaredNorm(), 0.0, 1.0) : 0.0;
+            const double height = (p - (e0 + along * d)).norm();
+            if (!(height <= reach)) return -1.0;
+            highest = std::max(highest, height);
+            drop[s] = drop[t] = 1;
+        }
+    if (highest < 0.0) return -1.0;
+    size_t kept = 0;
+    for (size_t t = 0; t < drop.size(); ++t) {
+        if (drop[t]) continue;
+        for (int k = 0; k < 3; ++k) triangles[3 * kept + k] = triangles[3 * t + k];
+        ++kept;
+    }
+    triangles.resize(3 * kept);
+    return highest;
+}
+
+namespace {
+
+// Whether a round's result `next` keeps the topology `before` of the mesh it came from, its
+// fins removed (within `reach`) if that is what it takes; `fins` receives their height (0
+// if none were removed), `culprits` (may be null) mesh_topology's for the result as given.
+bool round_keeps_topology(const MeshTopology &before, std::vector<uint32_t> &next, const std::vector<float> &positions,
+                          double reach, std::vector<uint32_t> *culprits, double &fins) {
+    fins = 0.0;
+    Mesh probe;  // mesh_topology reads the vertex count, not the positions
+    probe.vertices.assign(positions.size(), 0.0);
+    probe.triangles = next;
+    if (keeps_topology(before, mesh_topology(probe, culprits))) return true;
+    const double height = remove_fins(probe.triangles, positions, reach);
+    if (height < 0.0 || !keeps_topology(before, mesh_topology(probe))) return false;
+    next.swap(probe.triangles);
+    fins = height;
+    return true;
+}
+
+}  // namespace
+
 bool keeps_topology(const MeshTopology &before, const MeshTopology &after) {
     return after.same_as(before) && after.nonmanifold_edges <= before.nonmanifold_edges &&
            after.nonmanifold_vertices <= before.nonmanifold_vertices &&
@@ -178,12 +239,13 @@ PatchDecimation decimate_patch(const std::vector<float> &positions, std::vector<
                                                   next, round_error);
         if (known) next = first->triangles;
         if (3 * got >= triangles.size()) break;  // the error bound (or the locks) allow no collapse
-        probe.triangles = next;
         culprits.clear();
         if (known) culprits = first->culprits;
-        if (!known && keeps_topology(before, mesh_topology(probe, &culprits))) {
+        const double round_spent = known ? 0.0 : double(round_error) * scale;
+        double fins = 0.0;
+        if (!known && round_keeps_topology(before, next, positions, budget - result.spent - round_spent, &culprits, fins)) {
             triangles.swap(next);
-            result.spent += double(round_error) * scale;
+            result.spent += round_spent + fins;
             failures = 0;
             ask = target_triangles;
             continue;
@@ -249,10 +311,11 @@ Mesh simplify_mesh(const Mesh &mesh, size_t target_triangles, double target_erro
             probe.vertices.assign(base.vertices.size(), 0.0);
             probe.triangles = current;
             const MeshTopology before = mesh_topology(probe);
-            probe.triangles = trial.triangles;
-            if (scale > 0 && keeps_topology(before, mesh_topology(probe, &trial.culprits))) {
+            double fins = 0.0;
+            if (scale > 0 && round_keeps_topology(before, trial.triangles, positions,
+                                                  budget - double(round_error) * scale, &trial.culprits, fins)) {
                 current.swap(trial.triangles);
-                spent = double(round_error) * scale;
+                spent = double(round_error) * scale + fins;
             } else if (scale > 0) {
                 trial_broke = true;
             }

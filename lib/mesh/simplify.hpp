@@ -17,10 +17,13 @@ namespace gmpu {
 // Welds vertices at identical positions, then collapses edges until at most
 // `target_triangles` remain (0: no count target) or the next collapse would move the
 // surface by more than `target_error` × the bounding-box diagonal. A round whose result
-// changes the topology is retried with a smaller reduction, and simplification stops at
-// the last mesh that kept it. Meshes over 2 × kChunkTriangles are first decimated chunk by
-// chunk (chunked_decimation.hpp; on `workers` when given, reporting to `progress`), so a
-// retry redoes one chunk rather than the whole mesh. Vertices are a subset of the input's (positions exact, the
+// changes the topology is mended by dropping its fins (remove_fins) when that suffices,
+// else retried with a smaller reduction, and simplification stops at the last mesh that
+// kept it. Meshes over 2 × kChunkTriangles to be more than halved, whose first round over
+// the whole mesh reaches the count but breaks the topology, are decimated chunk by chunk
+// (chunked_decimation.hpp; on `workers` when given, reporting to `progress`), so a retry
+// redoes one chunk rather than the whole mesh.
+// Vertices are a subset of the input's (positions exact, the
 // confidence carried); normals are recomputed from the triangles, or with `keep_normals`
 // carried from the input when it has them (polygonize's normals are −∇f, exact at each
 // vertex). `achieved_error` (may be null) receives the accumulated error bound, as a
@@ -55,6 +58,15 @@ struct BrokenRound {
 PatchDecimation decimate_patch(const std::vector<float> &positions, std::vector<uint32_t> &triangles,
                                size_t target_triangles, double budget, const std::vector<char> *fixed = nullptr,
                                const BrokenRound *first = nullptr);
+
+// meshoptimizer can crush a thin tube's tip to a fin: a vertex left with only two
+// triangles, on the same three vertices in opposite order (two faces glued back to back
+// along the edge they hang from), so that the edge has four triangles and the round
+// changes the topology. Removes every fin of `triangles` (into `positions`, xyz floats)
+// whose vertex lies within `reach` of its edge (the surface moves by that much) and returns
+// the highest one's height; returns −1 and removes nothing when there is none or some fin
+// is higher (the tip of a real thin part, which a retry keeps).
+double remove_fins(std::vector<uint32_t> &triangles, const std::vector<float> &positions, double reach);
 
 // `after` is the same surface type as `before` (MeshTopology::same_as) and has no more
 // defects of any kind: a patch cut out of a manifold mesh may be pinched at a border

@@ -2,7 +2,8 @@
 // chunks share stay, so the chunks fit back together into the same closed surface, and a
 // chunk whose collapses break the topology is redone alone while the others keep their
 // single round. A whole mesh's first round, run already by simplify_mesh to choose between
-// chunks and the whole, is not run again by decimate_patch.
+// chunks and the whole, is not run again by decimate_patch. A round whose only break is a
+// fin low enough to drop is mended instead of redone.
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -142,11 +143,43 @@ void given_first_round_is_not_rerun(void **) {
     assert_int_equal(after.euler_characteristic, 0);
 }
 
+// A closed octahedron (6 vertices, 8 outward triangles) with a fin on its edge (0, 2): a
+// seventh vertex `height` above the edge's midpoint, in two triangles back to back.
+void octahedron_with_fin(std::vector<float> &positions, std::vector<uint32_t> &triangles, float height) {
+    positions = {1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0, 0, -1};
+    triangles = {0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5};
+    const float out = 0.5f + height / std::sqrt(2.0f);  // along the edge's outward bisector
+    positions.insert(positions.end(), {out, out, 0});
+    triangles.insert(triangles.end(), {6, 0, 2, 6, 2, 0});
+}
+
+void fins_within_reach_are_removed(void **) {
+    std::vector<float> positions;
+    std::vector<uint32_t> triangles;
+    octahedron_with_fin(positions, triangles, 0.1f);
+    const MeshTopology broken = topology(7, triangles);
+    assert_false(broken.manifold());  // the fin's edge has four triangles
+    std::vector<uint32_t> low = triangles;
+    assert_true(remove_fins(low, positions, 0.05) < 0.0);  // higher than the reach: kept
+    assert_true(low == triangles);
+    const double height = remove_fins(low, positions, 0.2);
+    assert_true(std::fabs(height - 0.1) < 1e-6);
+    assert_int_equal(low.size(), 24);
+    const MeshTopology mended = topology(7, low);
+    assert_true(mended.closed_manifold());
+    assert_int_equal(mended.euler_characteristic, 2);
+    // Two triangles at a vertex wound the same way are not a fin.
+    std::vector<uint32_t> twice = triangles;
+    twice[twice.size() - 2] = 0, twice[twice.size() - 1] = 2;
+    assert_true(remove_fins(twice, positions, 1.0) < 0.0);
+}
+
 }  // namespace
 
 int main() {
     const struct CMUnitTest tests[] = {cmocka_unit_test(chunk_borders_stay),
                                        cmocka_unit_test(failing_chunk_alone_is_retried),
-                                       cmocka_unit_test(given_first_round_is_not_rerun)};
+                                       cmocka_unit_test(given_first_round_is_not_rerun),
+                                       cmocka_unit_test(fins_within_reach_are_removed)};
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
