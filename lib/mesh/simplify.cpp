@@ -341,9 +341,9 @@ Mesh simplify_mesh(const Mesh &mesh, size_t target_triangles, double target_erro
         }
         spent += decimate_patch(positions, current, target_triangles, budget - spent, nullptr,
                                 trial_broke && !chunked ? &trial : nullptr).spent;
-        // Each chunk spends the error bound on its own share of the count, where the whole
-        // mesh collapses wherever it is cheapest: the chunks may use up the bound short of
-        // the count the whole mesh reaches. Then the whole mesh, from the start.
+        // The chunks stop at about the first round's error and the pass over the whole mesh
+        // has the rest of the bound, but its retries' locks can still leave it short of the
+        // count the whole mesh reaches alone. Then the whole mesh, from the start.
         if (chunked && target_triangles > 0 && current.size() / 3 > target_triangles) {
             std::vector<uint32_t> whole = base.triangles;
             const double whole_spent =

@@ -22,12 +22,11 @@ namespace gmpu {
 // kept it. Meshes over 2 × kChunkTriangles to be more than halved, whose first round over
 // the whole mesh reaches the count but breaks the topology, are decimated chunk by chunk
 // (chunked_decimation.hpp; on `workers` when given, reporting to `progress`), so a retry
-// redoes one chunk rather than the whole mesh.
-// Vertices are a subset of the input's (positions exact, the
-// confidence carried); normals are recomputed from the triangles, or with `keep_normals`
-// carried from the input when it has them (polygonize's normals are −∇f, exact at each
-// vertex). `achieved_error` (may be null) receives the accumulated error bound, as a
-// fraction of the diagonal. A mesh without triangles gives an empty mesh.
+// redoes one chunk rather than the whole mesh. Vertices are a subset of the input's
+// (positions exact, the confidence carried); normals are recomputed from the triangles, or
+// with `keep_normals` carried from the input when it has them (polygonize's normals are
+// −∇f, exact at each vertex). `achieved_error` (may be null) receives the accumulated error
+// bound, as a fraction of the diagonal. A mesh without triangles gives an empty mesh.
 Mesh simplify_mesh(const Mesh &mesh, size_t target_triangles, double target_error, double *achieved_error,
                    bool keep_normals = false, Workers *workers = nullptr, Progress *progress = nullptr);
 
@@ -44,7 +43,8 @@ struct PatchDecimation {
 };
 
 // A round of collapses already run on a patch, exactly as decimate_patch's first round
-// would run it, whose result broke the topology at `culprits` (mesh_topology's).
+// would run it, whose result broke the topology at `culprits` (mesh_topology's) even with
+// its fins dropped.
 struct BrokenRound {
     std::vector<uint32_t> triangles;
     std::vector<uint32_t> culprits;
