@@ -1,6 +1,7 @@
 #include "orient/leaf_graph.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "core/parallel.hpp"
 
@@ -34,6 +35,13 @@ private:
     std::vector<std::pair<uint64_t, uint32_t>> keys_;
 };
 
+// A corner this close to either shape's zero set (as a share of the cell size; the shapes
+// are about signed distances) lies on that surface, and the sign of the value there says
+// nothing: CAD parts have flat faces at round coordinates, which fall on the octree's cell
+// faces, where the plane fits give every corner of a shared face ±0 and the edge a random
+// J. There the two gradients, which the signs on either side of the surface follow, vote.
+constexpr double kOnSurface = 1e-5;
+
 // Sign agreement of two cells' raw shapes at the four corners of a's face (axis, side).
 int8_t face_agreement(const Octree &tree, const Cell &a, const Cell &b, int axis, int side) {
     const double h = 0.5 * a.size;
@@ -44,9 +52,11 @@ int8_t face_agreement(const Octree &tree, const Cell &a, const Cell &b, int axis
         x[axis] += side * h;
         x[u] += (k & 1) ? h : -h;
         x[v] += (k & 2) ? h : -h;
-        double qa = a.shape.value(x - a.centre, tree.pieces, nullptr);
-        double qb = b.shape.value(x - b.centre, tree.pieces, nullptr);
-        double p = qa * qb;
+        Eigen::Vector3d ga, gb;
+        const double qa = a.shape.value(x - a.centre, tree.pieces, &ga);
+        const double qb = b.shape.value(x - b.centre, tree.pieces, &gb);
+        const double on = kOnSurface * a.size;
+        const double p = std::abs(qa) <= on || std::abs(qb) <= on ? ga.dot(gb) : qa * qb;
         sum += (p > 0) - (p < 0);
     }
     return int8_t(sum);

@@ -1,7 +1,8 @@
 // The graph of paper §4.1: one node per leaf cell, an edge between leaves that share a face
 // (the paper's "4-connected" neighbours: two cells sharing four corners; across a change of
 // level, the smaller cell's face). Each edge carries J_ij = Σ_k sign(Q_i(x_k) Q_j(x_k)) over
-// the corners x_k of the shared face, so the smoothness energy of eq. (5) is
+// the corners x_k of the shared face (at a corner that lies on either fit's zero set, the
+// sign of ∇Q_i · ∇Q_j instead), so the smoothness energy of eq. (5) is
 // E_s(ℓ_i, ℓ_j) = −ℓ_i ℓ_j J_ij.
 #pragma once
 

@@ -6,6 +6,10 @@ Per cloud it runs gmpu (the CLI), Open3D's screened Poisson on gmpu's own orient
 and CGAL's Poisson pipelines either from the committed figures (tests/data/corpus/peers.tsv,
 the default: the peers take 5–50 s per cloud) or by running them here (`--corpus-peers live`).
 Everything is scored by gmpu-metrics; corpus_report.py turns the rows into tables.
+
+The held-out set (`make bench-heldout`) runs the same on 30 clouds that tests/data/heldout/make.sh
+samples from five meshes of CGAL's sample data that no setting was tuned on; it has no
+committed peer figures, so its peers always run here.
 """
 import csv
 import json
@@ -19,7 +23,12 @@ ROOT = Path(__file__).resolve().parents[2]
 CORPUS = ROOT / "tests" / "data" / "corpus"
 PEERS_TSV = CORPUS / "peers.tsv"
 IPSR_TSV = CORPUS / "ipsr_reference.tsv"
-CLOUD_COUNT = 106  # what make.sh writes: 17 closed meshes × 6 variants + 2 open × 2
+HELDOUT = ROOT / "tests" / "data" / "heldout"
+# What each set's make.sh writes, and where the meshes the clouds come from are.
+SETS = {
+    "corpus": {"make": CORPUS / "make.sh", "count": 106, "meshes": lambda out: CORPUS / "meshes"},  # 17 × 6 + 2 × 2
+    "heldout": {"make": HELDOUT / "make.sh", "count": 30, "meshes": lambda out: out / "meshes"},  # 5 × 6
+}
 
 VARIANTS = ("clean", "noise0.5", "noise1.0", "nonuniform", "sparse5k", "sparse1k")
 OPEN_MESHES = ("elephant-with-holes", "mech-holes-shark")
@@ -35,12 +44,15 @@ def variant_of(name):
 
 # ---- inputs ----
 
-def generate(out_dir):
-    """The 106 clouds, made by make.sh with its fixed seeds (kept between runs)."""
+def generate(out_dir, which="corpus"):
+    """The set's clouds, made by its make.sh with fixed seeds (kept between runs)."""
+    spec = SETS[which]
     out_dir.mkdir(parents=True, exist_ok=True)
-    if len(list(out_dir.glob("*_meta.json"))) != CLOUD_COUNT:
-        print(f"generating the corpus into {out_dir} (make.sh: a few minutes)", flush=True)
-        subprocess.run(["bash", str(CORPUS / "make.sh"), str(out_dir)], check=True)
+    meshes = spec["meshes"](out_dir)
+    if len(list(out_dir.glob("*_meta.json"))) != spec["count"] or not meshes.is_dir():
+        print(f"generating the {which} clouds into {out_dir} ({spec['make'].relative_to(ROOT)}: a few minutes)",
+              flush=True)
+        subprocess.run(["bash", str(spec["make"]), str(out_dir)], check=True)
     clouds = []
     for meta_path in sorted(out_dir.glob("*_meta.json")):
         name = meta_path.name[: -len("_meta.json")]
@@ -49,7 +61,7 @@ def generate(out_dir):
                        "points": meta["n"], "noise": meta["noise"],
                        "noise_abs": meta["noise_sigma_abs"],
                        "path": out_dir / f"{name}.ply", "gt_normals": out_dir / f"{name}_gt.ply",
-                       "gt_mesh": CORPUS / "meshes" / meta["mesh"]})
+                       "gt_mesh": meshes / meta["mesh"]})
     return clouds
 
 
@@ -163,15 +175,16 @@ def better_peer(runs):
 
 
 def run_corpus(args, metrics_exe, build):
-    """All the corpus rows; `args` carries out, corpus_peers, only, timeout, samples."""
+    """All the rows of a set; `args` carries out, corpus_set, corpus_peers, only, timeout, samples."""
     out = args.out
-    clouds = generate(out / "clouds")
+    which = getattr(args, "corpus_set", "corpus")
+    clouds = generate(out / "clouds", which)
     if args.only:
         clouds = [c for c in clouds if any(s in c["cloud"] for s in args.only.split(","))]
     gmpu = pipelines.Gmpu(build)
     gmpu.REPEATS = args.corpus_repeats
     poisson = pipelines.PoissonOnOrientedPoints()
-    live = args.corpus_peers == "live"
+    live = args.corpus_peers == "live" or which != "corpus"  # only the corpus has committed figures
     peers = [pipelines.Open3D(8), pipelines.Cgal(build)] if live else []
     for p in [gmpu, poisson, *peers]:
         why = p.available()
@@ -179,7 +192,7 @@ def run_corpus(args, metrics_exe, build):
             raise SystemExit(f"corpus: {p.name} cannot run: {why}")
     reference = {} if live else reference_peers()
     topology_cache, rows = {}, []
-    print(f"corpus: {len(clouds)} clouds; peers {'run live' if live else 'from ' + str(PEERS_TSV.relative_to(ROOT))}",
+    print(f"{which}: {len(clouds)} clouds; peers {'run live' if live else 'from ' + str(PEERS_TSV.relative_to(ROOT))}",
           flush=True)
     for cloud in clouds:
         workdir = out / "runs" / cloud["cloud"]
@@ -203,7 +216,8 @@ def run_corpus(args, metrics_exe, build):
         row["peer"] = better_peer(row["peer_runs"])
         rows.append(row)
         print(line(row), flush=True)
-    return {"rows": rows, "peer_source": "live" if live else "reference", "ipsr": ipsr_reference()}
+    return {"rows": rows, "set": which, "peer_source": "live" if live else "reference",
+            "ipsr": ipsr_reference() if which == "corpus" else {}}
 
 
 def line(row):

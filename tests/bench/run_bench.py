@@ -9,9 +9,11 @@ same clouds, in the same run, and are scored by the same exact metrics (gmpu-met
     make bench-corpus   the corpus section alone (--corpus-only, tests/bench/corpus.py):
                         106 clouds from tests/data/corpus/make.sh against issue 13's targets;
                         `make bench` runs it too
+    make bench-heldout  the same on 30 clouds of five models never tuned on
+                        (--heldout-only, tests/data/heldout/make.sh; peers run live)
 
 Results go to bench-results/ (results.json, results.md, *.png, renders/; the corpus section
-in bench-results/corpus/: corpus.json, corpus.md); then tests/bench/update_readme.py puts
+in bench-results/corpus/: corpus.json, corpus.md; the held-out one in bench-results/heldout/); then tests/bench/update_readme.py puts
 the summaries into the README.
 """
 import argparse
@@ -272,12 +274,12 @@ def corpus_section(args, metrics_exe, build):
     import corpus
     import corpus_report
 
-    out = args.out / "corpus"
+    out = args.out / args.corpus_set
     results = corpus.run_corpus(argparse.Namespace(**{**vars(args), "out": out}), metrics_exe, build)
     results["machine"] = machine()
     (out / "corpus.json").write_text(json.dumps(results, indent=1, default=str))
     corpus_report.write(results, out)
-    print(f"corpus section in {out}/corpus.md")
+    print(f"{args.corpus_set} section in {out}/corpus.md")
     return 0
 
 
@@ -301,6 +303,8 @@ def main():
     ap.add_argument("--no-renders", dest="renders", action="store_false")
     ap.add_argument("--corpus-only", action="store_true",
                     help="only the corpus section (tests/data/corpus, issue 13)")
+    ap.add_argument("--heldout-only", action="store_true",
+                    help="only the held-out section (tests/data/heldout: models never tuned on)")
     ap.add_argument("--corpus-peers", choices=("reference", "live"), default="reference",
                     help="the peers on the corpus: committed figures (peers.tsv) or run here")
     ap.add_argument("--corpus-repeats", type=int, default=1,
@@ -319,7 +323,8 @@ def main():
         sys.exit(f"{metrics_exe} is missing: build first (make build)")
     if args.quick:
         return quick(args, metrics_exe, args.build)
-    if args.corpus_only:
+    args.corpus_set = "heldout" if args.heldout_only else "corpus"
+    if args.corpus_only or args.heldout_only:
         return corpus_section(args, metrics_exe, args.build)
     return full(args, metrics_exe, args.build)
 

@@ -8,6 +8,7 @@ Each section replaces what lies between its two marker lines in the README:
   bench   RESULTS_DIR/summary.md         between `<!-- bench:begin -->` and `<!-- bench:end -->`
           (or, failing those, `<!-- results:begin -->` / `<!-- results:end -->`)
   corpus  RESULTS_DIR/corpus/corpus.md   between `<!-- corpus:begin -->` and `<!-- corpus:end -->`
+  heldout RESULTS_DIR/heldout/corpus.md  between `<!-- heldout:begin -->` and `<!-- heldout:end -->`
 A section whose file is missing is skipped (said on stdout) unless it was asked for by
 --sections; the plots and renders a section links to are copied into the assets folder
 (bench-results/ itself is not committed). Exits 1 when the README lacks a section's markers,
@@ -24,6 +25,7 @@ SECTIONS = {
     "bench": ("summary.md", [("<!-- bench:begin -->", "<!-- bench:end -->"),
                              ("<!-- results:begin -->", "<!-- results:end -->")]),
     "corpus": ("corpus/corpus.md", [("<!-- corpus:begin -->", "<!-- corpus:end -->")]),
+    "heldout": ("heldout/corpus.md", [("<!-- heldout:begin -->", "<!-- heldout:end -->")]),
 }
 
 
@@ -61,7 +63,7 @@ def main():
     ap.add_argument("--readme", type=Path, default=ROOT / "README.md")
     ap.add_argument("--assets", type=Path, default=ROOT / "docs" / "bench",
                     help="where the linked PNGs are copied (committed with the README)")
-    ap.add_argument("--sections", default="", help="comma-separated: bench, corpus (default: "
+    ap.add_argument("--sections", default="", help="comma-separated: bench, corpus, heldout (default: "
                     "every section whose file the results folder has)")
     args = ap.parse_args()
 

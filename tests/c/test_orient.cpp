@@ -75,9 +75,10 @@ std::set<std::pair<uint32_t, uint32_t>> face_neighbours(const Octree &tree, cons
 }
 
 // Root, its 8 children, and the 8 children of octant 7: 7 + 8 leaves. Every shape is the
-// same global plane x = 0.05 (no face corner lies on it), except `flipped` (a cell index,
-// or -1), whose shape is negated.
-Octree two_level_octree(int flipped) {
+// same global plane x = `plane` (at 0.05 no face corner lies on it; at 0, the root's middle,
+// the faces between the two halves lie in it), except `flipped` (a cell index, or -1), whose
+// shape is negated.
+Octree two_level_octree(int flipped, double plane = 0.05) {
     Octree t;
     auto add = [&](Vector3d centre, double size, int depth, const uint16_t coord[3], int parent) {
         Cell c;
@@ -87,7 +88,7 @@ Octree two_level_octree(int flipped) {
         for (int d = 0; d < 3; ++d) c.coord[d] = coord[d];
         c.parent = parent;
         c.shape.model = Model::bivariate;
-        c.shape.q = Quadric::affine({1, 0, 0}, centre[0] - 0.05);
+        c.shape.q = Quadric::affine({1, 0, 0}, centre[0] - plane);
         if (int(t.cells.size()) == flipped) c.shape.q *= -1.0;
         t.cells.push_back(c);
     };
@@ -234,6 +235,27 @@ void leaf_graph_of_a_known_octree(void **) {
         disagreeing += touches;
     }
     assert_int_equal(disagreeing, 6);  // a small corner leaf: 3 small and 3 large neighbours
+}
+
+// A flat face on the cells' faces (a CAD part's face at a round coordinate): the corners
+// there lie on every leaf's plane, where the sign of the values is that of rounding, so the
+// gradients decide. By signs alone the edges across the plane had J = 0 and those along it 2.
+void leaf_graph_decides_corners_on_the_surface_by_the_gradients(void **) {
+    Progress quiet(nullptr, nullptr, GMPU_STAGE_ORIENT);
+    Workers workers(1);
+    LeafGraph g = build_leaf_graph(two_level_octree(-1, 0.0), workers, quiet);
+    EdgeSet edges = edges_of(g);
+    assert_int_equal(edges.size(), 33);
+    for (const auto &[a, b, j] : edges) assert_int_equal(j, 4);
+    const uint32_t flipped = 9;  // a small leaf beside the plane: one of its faces lies in it
+    g = build_leaf_graph(two_level_octree(int(flipped), 0.0), workers, quiet);
+    int disagreeing = 0;
+    for (const auto &[a, b, j] : edges_of(g)) {
+        const bool touches = g.cell_of[a] == flipped || g.cell_of[b] == flipped;
+        assert_int_equal(j, touches ? -4 : 4);
+        disagreeing += touches;
+    }
+    assert_int_equal(disagreeing, 6);
 }
 
 // A Fibonacci sphere (near-uniform, deterministic), its radius modulated by `bump` so that
@@ -446,6 +468,7 @@ void outward_pass_orients_nested_shells(void **) {
 int main() {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(leaf_graph_of_a_known_octree),
+        cmocka_unit_test(leaf_graph_decides_corners_on_the_surface_by_the_gradients),
         cmocka_unit_test(leaf_graph_matches_brute_force_on_a_fitted_octree),
         cmocka_unit_test(front_recovers_a_consistent_orientation),
         cmocka_unit_test(bp_is_right_where_the_vote_is_wrong),

@@ -85,3 +85,38 @@ def test_update_readme_rewrites_the_corpus_section_alone(tmp_path):
     assert done.returncode == 0, done.stderr
     assert readme.read_text() == ("a\n<!-- bench:begin -->\nold bench\n<!-- bench:end -->\n"
                                   "<!-- corpus:begin -->\nnew corpus\n<!-- corpus:end -->\nz\n")
+
+
+def test_the_heldout_section_is_judged_alike_without_ipsr_or_committed_peers():
+    rows = [row("homer_clean", orientation_accuracy=0.99), row("homer_sparse1k")]
+    text = corpus_report.section({"rows": rows, "set": "heldout", "peer_source": "live", "ipsr": {}}, "a machine")
+    assert "on models not tuned on" in text and "tests/data/heldout/make.sh" in text
+    assert "**missed** (met on 1/2; missed: homer_clean)" in text
+    assert "iPSR" not in text and "peers.tsv" not in text
+
+
+def test_the_heldout_models_are_not_in_the_corpus():
+    # Held out means never tuned on: a model that joins the corpus must leave this set.
+    script = (REPO / "tests" / "data" / "heldout" / "make.sh").read_text()
+    models = next(l for l in script.splitlines() if l.startswith("models=")).split("=", 1)[1].strip('"').split()
+    assert len(models) == 5
+    corpus_meshes = {p.stem for p in (REPO / "tests" / "data" / "corpus" / "meshes").iterdir()}
+    shared_meshes = {p.stem.split("_")[0] for p in (REPO / "tests" / "data").rglob("*.off")
+                     if "heldout" not in p.parts}
+    assert not set(models) & (corpus_meshes | shared_meshes)
+    assert corpus.SETS["heldout"]["count"] == 6 * len(models)
+    assert corpus.SETS["heldout"]["meshes"](Path("/x")) == Path("/x/meshes")
+
+
+def test_update_readme_rewrites_the_heldout_section_alone(tmp_path):
+    readme = tmp_path / "README.md"
+    readme.write_text("<!-- corpus:begin -->\nold corpus\n<!-- corpus:end -->\n"
+                      "<!-- heldout:begin -->\n<!-- heldout:end -->\n")
+    (tmp_path / "results" / "heldout").mkdir(parents=True)
+    (tmp_path / "results" / "heldout" / "corpus.md").write_text("held out\n")
+    done = subprocess.run([sys.executable, str(REPO / "tests" / "bench" / "update_readme.py"),
+                           str(tmp_path / "results"), "--readme", str(readme), "--assets",
+                           str(tmp_path / "assets"), "--sections", "heldout"], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert readme.read_text() == ("<!-- corpus:begin -->\nold corpus\n<!-- corpus:end -->\n"
+                                  "<!-- heldout:begin -->\nheld out\n<!-- heldout:end -->\n")

@@ -1,0 +1,31 @@
+#!/usr/bin/env bash
+# Generates the held-out clouds: five closed meshes gmpu was never tuned on, from CGAL's
+# sample data as Debian's libcgal-dev ships it (the bench's CGAL peer), sampled like the
+# development corpus (tests/data/corpus/make.sh: clean, noise σ 0.5 % and 1 % of the
+# diagonal, ten-fold nonuniform density, 5k and 1k points) with their own fixed seeds.
+# Usage: make.sh OUTDIR   (the meshes go to OUTDIR/meshes; about a minute)
+set -euo pipefail
+here=$(cd "$(dirname "$0")" && pwd); out=${1:?usage: make.sh OUTDIR}
+data=${CGAL_SAMPLE_DATA:-/usr/share/doc/libcgal-dev/data.tar.gz}
+if [ ! -f "$data" ]; then
+  echo "heldout: $data is missing: install Debian's libcgal-dev (make deps-bench)" >&2
+  exit 1
+fi
+# armadillo and homer: organic; turbine (genus 11) and anchor_dense (genus 4): CAD parts;
+# cheese: a block with 133 small holes (porous).
+models="armadillo homer turbine anchor_dense cheese"
+mkdir -p "$out/meshes"
+tar xzf "$data" -C "$out/meshes" --strip-components=2 $(for m in $models; do echo "data/meshes/$m.off"; done)
+S="/usr/bin/python3 $here/../tools/sample.py"
+seed=5000
+for m in $models; do
+  M="$out/meshes/$m.off"
+  $S "$M" "$out/${m}_clean.ply"      --n 35000 --seed $seed                 >/dev/null
+  $S "$M" "$out/${m}_noise0.5.ply"   --n 35000 --noise 0.005 --seed $((seed+1)) >/dev/null
+  $S "$M" "$out/${m}_noise1.0.ply"   --n 35000 --noise 0.010 --seed $((seed+2)) >/dev/null
+  $S "$M" "$out/${m}_nonuniform.ply" --n 35000 --nonuniform --axis 2 --seed $((seed+3)) >/dev/null
+  $S "$M" "$out/${m}_sparse5k.ply"   --n 5000  --seed $((seed+4))           >/dev/null
+  $S "$M" "$out/${m}_sparse1k.ply"   --n 1000  --seed $((seed+5))           >/dev/null
+  seed=$((seed+10))
+done
+echo "heldout: $(ls "$out"/*_meta.json | wc -l) clouds in $out"
