@@ -1,9 +1,11 @@
-"""The benchmark's corpus section judges issue 13's targets per cloud (tests/bench/
-corpus_report.py) and writes its own README section (tests/bench/update_readme.py): both
+"""The benchmark's corpus and held-out sections judge issue 13's targets per cloud (tests/bench/
+corpus_report.py) and write their own README sections (tests/bench/update_readme.py): all
 checked here on made-up rows, without running anything."""
 import subprocess
 import sys
 from pathlib import Path
+
+import pytest
 
 REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO / "tests" / "bench"))
@@ -73,18 +75,24 @@ def test_the_section_names_every_target_and_the_peer_source():
     assert "| bear_sparse1k | 0.900 | 0.990 | 30 |" in text and "75× ✗" in text
 
 
-def test_update_readme_rewrites_the_corpus_section_alone(tmp_path):
+@pytest.mark.parametrize("section", ["corpus", "heldout"])
+def test_update_readme_rewrites_one_section_alone(tmp_path, section):
     readme = tmp_path / "README.md"
-    readme.write_text("a\n<!-- bench:begin -->\nold bench\n<!-- bench:end -->\n"
-                      "<!-- corpus:begin -->\nold corpus\n<!-- corpus:end -->\nz\n")
-    (tmp_path / "results" / "corpus").mkdir(parents=True)
-    (tmp_path / "results" / "corpus" / "corpus.md").write_text("new corpus\n")
+    other = "heldout" if section == "corpus" else "corpus"
+    readme.write_text(f"a\n<!-- bench:begin -->\nold bench\n<!-- bench:end -->\n"
+                      f"<!-- {section}:begin -->\nold\n<!-- {section}:end -->\n"
+                      f"<!-- {other}:begin -->\nkept\n<!-- {other}:end -->\nz\n")
+    (tmp_path / "results" / section).mkdir(parents=True)
+    (tmp_path / "results" / section / "corpus.md").write_text("new\n")
+    (tmp_path / "results" / other).mkdir(parents=True)
+    (tmp_path / "results" / other / "corpus.md").write_text("not asked for\n")
     done = subprocess.run([sys.executable, str(REPO / "tests" / "bench" / "update_readme.py"),
                            str(tmp_path / "results"), "--readme", str(readme), "--assets",
-                           str(tmp_path / "assets"), "--sections", "corpus"], capture_output=True, text=True)
+                           str(tmp_path / "assets"), "--sections", section], capture_output=True, text=True)
     assert done.returncode == 0, done.stderr
-    assert readme.read_text() == ("a\n<!-- bench:begin -->\nold bench\n<!-- bench:end -->\n"
-                                  "<!-- corpus:begin -->\nnew corpus\n<!-- corpus:end -->\nz\n")
+    assert readme.read_text() == (f"a\n<!-- bench:begin -->\nold bench\n<!-- bench:end -->\n"
+                                  f"<!-- {section}:begin -->\nnew\n<!-- {section}:end -->\n"
+                                  f"<!-- {other}:begin -->\nkept\n<!-- {other}:end -->\nz\n")
 
 
 def test_the_heldout_section_is_judged_alike_without_ipsr_or_committed_peers():
@@ -106,17 +114,3 @@ def test_the_heldout_models_are_not_in_the_corpus():
     assert not set(models) & (corpus_meshes | shared_meshes)
     assert corpus.SETS["heldout"]["count"] == 6 * len(models)
     assert corpus.SETS["heldout"]["meshes"](Path("/x")) == Path("/x/meshes")
-
-
-def test_update_readme_rewrites_the_heldout_section_alone(tmp_path):
-    readme = tmp_path / "README.md"
-    readme.write_text("<!-- corpus:begin -->\nold corpus\n<!-- corpus:end -->\n"
-                      "<!-- heldout:begin -->\n<!-- heldout:end -->\n")
-    (tmp_path / "results" / "heldout").mkdir(parents=True)
-    (tmp_path / "results" / "heldout" / "corpus.md").write_text("held out\n")
-    done = subprocess.run([sys.executable, str(REPO / "tests" / "bench" / "update_readme.py"),
-                           str(tmp_path / "results"), "--readme", str(readme), "--assets",
-                           str(tmp_path / "assets"), "--sections", "heldout"], capture_output=True, text=True)
-    assert done.returncode == 0, done.stderr
-    assert readme.read_text() == ("<!-- corpus:begin -->\nold corpus\n<!-- corpus:end -->\n"
-                                  "<!-- heldout:begin -->\nheld out\n<!-- heldout:end -->\n")

@@ -16,16 +16,10 @@ fi
 models="armadillo homer turbine anchor_dense cheese"
 mkdir -p "$out/meshes"
 tar xzf "$data" -C "$out/meshes" --strip-components=2 $(for m in $models; do echo "data/meshes/$m.off"; done)
-S="/usr/bin/python3 $here/../tools/sample.py"
+source "$here/../tools/variants.sh"
 seed=5000
 for m in $models; do
-  M="$out/meshes/$m.off"
-  $S "$M" "$out/${m}_clean.ply"      --n 35000 --seed $seed                 >/dev/null
-  $S "$M" "$out/${m}_noise0.5.ply"   --n 35000 --noise 0.005 --seed $((seed+1)) >/dev/null
-  $S "$M" "$out/${m}_noise1.0.ply"   --n 35000 --noise 0.010 --seed $((seed+2)) >/dev/null
-  $S "$M" "$out/${m}_nonuniform.ply" --n 35000 --nonuniform --axis 2 --seed $((seed+3)) >/dev/null
-  $S "$M" "$out/${m}_sparse5k.ply"   --n 5000  --seed $((seed+4))           >/dev/null
-  $S "$M" "$out/${m}_sparse1k.ply"   --n 1000  --seed $((seed+5))           >/dev/null
+  sample_variants "$out/meshes/$m.off" "$out" "$m" $seed
   seed=$((seed+10))
 done
 echo "heldout: $(ls "$out"/*_meta.json | wc -l) clouds in $out"
