@@ -23,6 +23,11 @@ constexpr double kFullSupport = 16384;
 // (ε / error)^kStrandedPower: where finer leaves reach, they decide; where none does, it
 // still stands in.
 constexpr double kStrandedPower = 2.0;
+// Two-sheet cells whose sheets end inside the support (a plate's rim) are split this many
+// levels below the first such cell: the fin their fits make past the rim shrinks with the
+// cell, and two levels take most of it at a quarter of the cells that splitting down to
+// N_min would make.
+constexpr uint8_t kMaxRimSplits = 2;
 
 // Memory model of fit, for GMPU_PARAM_MAX_MEMORY (upper estimates of the peak): per point,
 // the points and their kd-trees and the octree's order; per cell, the cell, its copy among
@@ -63,7 +68,7 @@ struct Builder {
     double support_radius(double size) const { return params.support_scale * std::sqrt(3.0) * size; }
 
     bool should_subdivide(const Cell &c) const {
-        return (c.error > epsilon || c.unresolved_sheets) && c.depth < params.max_depth &&
+        return (c.error > epsilon || c.unresolved_sheets || c.split_at_rim) && c.depth < params.max_depth &&
                c.initial_count >= uint32_t(params.min_points);
     }
 
@@ -104,6 +109,7 @@ struct Builder {
         for (size_t k = 0; k < idx.size(); ++k) support[k] = points.point(idx[k]) - c.centre;
         CellFit f = fit_cell(support, c.radius, epsilon, requested, params, close_sheets);
         c.unresolved_sheets = f.unresolved_sheets;
+        c.split_at_rim = f.sheets_end && f.error <= epsilon && c.rim_splits_above < kMaxRimSplits;
         c.support_count = uint32_t(std::max(double(idx.size()), estimate));
         c.error = float(f.error);
         c.variation = float(f.variation);
@@ -155,6 +161,7 @@ struct Builder {
             }
             c.point_begin = start[o];
             c.point_end = start[o + 1];
+            c.rim_splits_above = uint8_t(parent.rim_splits_above + (parent.split_at_rim ? 1 : 0));
             if (!fit(c, count[o] > 0, child.piece)) continue;
             kids.push_back(child);
             kids.back().cell.child_mask = 0;

@@ -72,7 +72,10 @@ CellFit fit_cell(const PointList &support, double radius, double epsilon, double
         CellFit two;
         two.variation = fit.variation;
         const SheetSplit split = fit_two_sheets(support, fit.shape, fit.error, radius, close_sheets, epsilon, two);
-        if (two.shape.model == Model::two_sheets) return two;
+        if (two.shape.model == Model::two_sheets) {
+            two.sheets_end = split.ends && epsilon <= requested;
+            return two;
+        }
         fit.unresolved_sheets = split.found;
     }
     if (epsilon <= requested && support.size() <= kThinPartMaxSupport && fit.shape.model == Model::bivariate &&

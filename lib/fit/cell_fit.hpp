@@ -25,6 +25,10 @@ struct CellFit {
     // Two sheets were seen in the support but no model here fits them: the cell must be
     // split whatever its error (its single fit passes between the sheets).
     bool unresolved_sheets = false;
+    // A noise-free two-sheet fit whose sheets end inside the support (two_sheet_fit.hpp):
+    // worth splitting even when it meets ε. Under noise the points between close sheets are
+    // the noise, not a rim, so noisy fits never ask.
+    bool sheets_end = false;
 };
 
 // `support` holds the support points relative to the cell centre, `radius` is R.

@@ -156,6 +156,26 @@ bool fit_sheets(const PointList &pts, std::vector<int> &label, double radius, Qu
     return true;
 }
 
+// The sheets end inside the support when at least kEndPoints, and kEndShare of the sampled
+// points, lie deeper than kEndDepth of the gap from both sheets. Only where the sampling
+// resolves the gap (kEndResolved sample spacings or more): sheets closer than that are fitted
+// through points that straddle them, and those read as a rim face everywhere.
+constexpr double kEndDepth = 0.25;
+constexpr size_t kEndPoints = 4;
+constexpr double kEndShare = 0.01;
+constexpr double kEndResolved = 0.5;
+
+// The sample spacing of two sheets that cross a support ball of radius R with n points
+// (two discs of area π R² between them).
+double two_sheet_spacing(size_t n, double radius) { return radius * std::sqrt(2.0 * M_PI / double(std::max<size_t>(1, n))); }
+
+bool sheets_end(const PointList &pts, const PiecewiseShape &shape, double gap) {
+    size_t deep = 0;
+    for (const auto &p : pts)
+        deep += std::min(signed_distance(shape.part[0], p), signed_distance(shape.part[1], p)) > kEndDepth * gap;
+    return deep >= std::max(kEndPoints, size_t(kEndShare * double(pts.size())));
+}
+
 }  // namespace
 
 SheetSplit fit_two_sheets(const PointList &support, const LocalShape &single, double single_error, double radius,
@@ -206,6 +226,7 @@ SheetSplit fit_two_sheets(const PointList &support, const LocalShape &single, do
     out.shape = local;
     out.piece = shape;
     out.error = error;
+    split.ends = groups.gap >= kEndResolved * two_sheet_spacing(support.size(), radius) && sheets_end(pts, shape, groups.gap);
     return split;
 }
 

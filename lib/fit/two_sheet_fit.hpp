@@ -15,6 +15,10 @@ namespace gmpu {
 struct SheetSplit {
     bool found = false;  // the single fit's distances form two well-separated groups
     double gap = 0.0;    // distance between the groups' means
+    // The fitted sheets end inside the support: enough points lie deep between them (a
+    // plate's rim face). Their fits run on past the rim, converging, and the blend leaves a
+    // fin there unless the cell is split down to the rim.
+    bool ends = false;
 };
 
 // Looks for two sheets in `support` around the fitted `single` shape. Fills `out` with the

@@ -211,7 +211,7 @@ void polygonize_block(const BlockGrid &g, const SurfaceField &f, const PointBuck
 double median_leaf_size(const Octree &tree) {
     std::vector<double> sizes;
     for (const Cell &c : tree.cells)
-        if (c.is_leaf() && c.point_end > c.point_begin) sizes.push_back(c.size);
+        if (c.is_sizing_leaf()) sizes.push_back(c.size);
     if (sizes.empty()) return INFINITY;
     std::nth_element(sizes.begin(), sizes.begin() + long(sizes.size() / 2), sizes.end());
     return sizes[sizes.size() / 2];
@@ -223,7 +223,7 @@ double thin_wall_gap(const Octree &tree) {
     std::vector<std::pair<double, uint32_t>> walls;  // gap, points
     double points = 0.0;
     for (const Cell &c : tree.cells) {
-        if (!c.is_leaf() || c.point_end == c.point_begin) continue;
+        if (!c.is_sizing_leaf()) continue;
         points += double(c.point_end - c.point_begin);
         if (c.shape.model == Model::two_sheets)
             walls.push_back({tree.pieces[size_t(c.shape.piece)].sheet_gap(), c.point_end - c.point_begin});

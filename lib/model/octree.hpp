@@ -35,6 +35,11 @@ struct Cell {
     float error = 0.0f;               // Taubin distance error of the fit (normalised units)
     float variation = 0.0f;           // PCA surface variation σ of the support
     bool unresolved_sheets = false;   // fit saw two sheets it could not model: split anyway
+    // Its two-sheet fit meets ε but the sheets end inside the support (a plate's rim): split
+    // anyway, a bounded number of times (build_octree.cpp), counted down the tree by
+    // rim_splits_above.
+    bool split_at_rim = false;
+    uint8_t rim_splits_above = 0;
     // Factor on the cell's partition-of-unity weight: 1, except for a leaf whose fit misses
     // ε but which could not be split because no child would be near the data (see
     // build_octree.cpp): its coarse fit is unreliable wherever a finer leaf has a say.
@@ -42,6 +47,11 @@ struct Cell {
     LocalShape shape;
 
     bool is_leaf() const { return child_mask == 0; }
+    // The leaf as the grid's size sees it: the rim's extra refinement below a cell that was
+    // split at its rim does not make the whole grid finer.
+    bool is_sizing_leaf() const {
+        return rim_splits_above == 0 && (is_leaf() || split_at_rim) && point_end > point_begin;
+    }
 };
 
 // Orientation labels ℓ_i, one per cell: +1 keeps the fitted sign of the cell's shape, −1

@@ -260,6 +260,45 @@ void two_noisy_sheets_without_cloud_evidence(void **) {
     assert_true(fit_cell(c.wall, 1.5, floor, tight, params, CloseSheets::off).shape.model != Model::two_sheets);
 }
 
+// A plate's end in one support: two clean sheets z = ±gap/2 for x < 0.5 (`sheet_points`
+// over them), the rim face at x = 0.5 joining them (`rim_points`), in the ball of radius
+// 1.5 around the origin.
+PointList plate_end(int sheet_points, int rim_points, double gap, uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> u(-1.5, 1.5), unit(0, 1);
+    PointList pts;
+    for (int i = 0; i < sheet_points; ++i)
+        pts.emplace_back(unit(rng) * 2.0 - 1.5, u(rng), unit(rng) < 0.5 ? -gap / 2 : gap / 2);
+    for (int i = 0; i < rim_points; ++i) pts.emplace_back(0.5, u(rng), gap * (unit(rng) - 0.5));
+    return pts;
+}
+
+void two_sheets_that_end_ask_for_a_split(void **) {
+    // Sheets fitted past their rim run on and meet beyond it (a fin around a plate's
+    // outline); the fit says so, on noise-free fits whose sampling resolves the gap.
+    Params params;
+    const double tight = 1e-4;
+    // 3,000 sheet points and the rim face's share of the area (about 2 %).
+    const PointList rim = plate_end(3000, 60, 0.1, 51);
+    const CellFit end = fit_cell(rim, 1.5, tight, tight, params);
+    assert_true(end.shape.model == Model::two_sheets);
+    assert_true(end.sheets_end);
+    // The same sheets without the rim face: they run through the support.
+    const CellFit wall = fit_cell(plate_end(3000, 0, 0.1, 51), 1.5, tight, tight, params);
+    assert_true(wall.shape.model == Model::two_sheets);
+    assert_false(wall.sheets_end);
+    // Where ε is the noise floor the points between close sheets are noise, not a rim.
+    const CellFit noisy = fit_cell(rim, 1.5, 10 * tight, tight, params);
+    assert_true(noisy.shape.model == Model::two_sheets);
+    assert_false(noisy.sheets_end);
+    // Sheets sampled more coarsely than twice their gap: there, points between them are
+    // more often the sheets' own, straddled by fits through too few points, than a rim face,
+    // however many there are.
+    const CellFit sparse = fit_cell(plate_end(150, 20, 0.1, 51), 1.5, tight, tight, params);
+    assert_true(sparse.shape.model == Model::two_sheets);
+    assert_false(sparse.sheets_end);
+}
+
 void noise_estimate_ignores_sparse_detail(void **) {
     // 1,500 clean points on a sphere with 30 ridges around it, each about two sample spacings
     // wide at the equator and narrower towards the poles: what a local quadric cannot follow
@@ -937,6 +976,7 @@ int main(void) {
         cmocka_unit_test(noise_estimate_sees_through_a_noisy_wall),
         cmocka_unit_test(two_noisy_sheets_in_one_support),
         cmocka_unit_test(two_noisy_sheets_without_cloud_evidence),
+        cmocka_unit_test(two_sheets_that_end_ask_for_a_split),
         cmocka_unit_test(point_set_validation),
         cmocka_unit_test(outliers_are_far_from_everything),
         cmocka_unit_test(clusters_are_groups_far_apart),
