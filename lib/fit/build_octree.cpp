@@ -24,9 +24,9 @@ constexpr double kFullSupport = 16384;
 // still stands in.
 constexpr double kStrandedPower = 2.0;
 // Two-sheet cells whose sheets end inside the support (a plate's rim) are split this many
-// levels below the first such cell: the fin their fits make past the rim shrinks with the
-// cell, and two levels take most of it at a quarter of the cells that splitting down to
-// N_min would make.
+// levels below the first such cell: past the rim their slab runs on until other leaves take
+// over, and smaller cells there leave less of it. One level left most of a tube's fin; more
+// than two add cells without closing what two leave.
 constexpr uint8_t kMaxRimSplits = 2;
 
 // Memory model of fit, for GMPU_PARAM_MAX_MEMORY (upper estimates of the peak): per point,

@@ -16,8 +16,8 @@ struct SheetSplit {
     bool found = false;  // the single fit's distances form two well-separated groups
     double gap = 0.0;    // distance between the groups' means
     // The fitted sheets end inside the support: enough points lie deep between them (a
-    // plate's rim face). Their fits run on past the rim, converging, and the blend leaves a
-    // fin there unless the cell is split down to the rim.
+    // plate's rim face). The two-sheet model has no end, so its slab runs on past the rim
+    // and the blend leaves a fin there unless the cell is split towards the rim.
     bool ends = false;
 };
 
