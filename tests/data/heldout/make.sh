@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Generates the held-out clouds: five closed meshes gmpu was never tuned on, from CGAL's
-# sample data as Debian's libcgal-dev ships it (the bench's CGAL peer), sampled like the
+# sample data as Debian's libcgal-demo ships it (beside the bench's CGAL peer, libcgal-dev), sampled like the
 # development corpus (tests/data/corpus/make.sh: clean, noise σ 0.5 % and 1 % of the
 # diagonal, ten-fold nonuniform density, 5k and 1k points) with their own fixed seeds.
 # Usage: make.sh OUTDIR   (the meshes go to OUTDIR/meshes; about a minute)
@@ -8,7 +8,7 @@ set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd); out=${1:?usage: make.sh OUTDIR}
 data=${CGAL_SAMPLE_DATA:-/usr/share/doc/libcgal-dev/data.tar.gz}
 if [ ! -f "$data" ]; then
-  echo "heldout: $data is missing: install Debian's libcgal-dev (make deps-bench)" >&2
+  echo "heldout: $data is missing: install Debian's libcgal-demo (make deps-bench)" >&2
   exit 1
 fi
 # armadillo and homer: organic; turbine (genus 11) and anchor_dense (genus 4): CAD parts;
