@@ -15,7 +15,7 @@ TEST_PKGS := $(CORE_PKGS) python3-cffi python3-numpy python3-pytest python3-matp
              valgrind clang libclang-rt-14-dev time python3-open3d \
              cmake python3-venv python3-mesonpy python3-build
 # libcgal-demo: CGAL's sample meshes (/usr/share/doc/libcgal-dev/data.tar.gz), the held-out models.
-BENCH_PKGS := $(TEST_PKGS) python3-open3d libcgal-dev libcgal-demo libgmp-dev libmpfr-dev time
+BENCH_PKGS := $(TEST_PKGS) libcgal-dev libcgal-demo libgmp-dev libmpfr-dev
 
 define apt_install
 	@missing=""; for p in $(1); do dpkg -s $$p >/dev/null 2>&1 || missing="$$missing $$p"; done; \
@@ -234,7 +234,8 @@ bench-corpus: deps-bench build
 	$(PYTHON) tests/bench/update_readme.py bench-results --sections corpus
 
 # The held-out section alone: the corpus's targets on 30 clouds of five models no setting was
-# tuned on (tests/data/heldout/make.sh, from CGAL's sample data in Debian's libcgal-demo; peers run live, ~15 min).
+# tuned on (tests/data/heldout/make.sh, from CGAL's sample data in Debian's libcgal-demo;
+# peers run live, ~15 min).
 .PHONY: bench-heldout
 bench-heldout: deps-bench build
 	$(PYTHON) tests/bench/run_bench.py --heldout-only --build $(BUILD) --out bench-results

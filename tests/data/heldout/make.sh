@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Generates the held-out clouds: five closed meshes gmpu was never tuned on, from CGAL's
-# sample data as Debian's libcgal-demo ships it (beside the bench's CGAL peer, libcgal-dev), sampled like the
-# development corpus (tests/data/corpus/make.sh: clean, noise σ 0.5 % and 1 % of the
-# diagonal, ten-fold nonuniform density, 5k and 1k points) with their own fixed seeds.
+# sample data as Debian's libcgal-demo ships it (beside the bench's CGAL peer, libcgal-dev),
+# sampled like the development corpus (tests/data/corpus/make.sh: clean, noise σ 0.5 % and
+# 1 % of the diagonal, ten-fold nonuniform density, 5k and 1k points) with their own fixed
+# seeds.
 # Usage: make.sh OUTDIR   (the meshes go to OUTDIR/meshes; about a minute)
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd); out=${1:?usage: make.sh OUTDIR}
