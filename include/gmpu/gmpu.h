@@ -177,9 +177,13 @@ typedef enum gmpu_param {
      * smooth implicit's shape where the blend strays (past the end of a thin part, bridges
      * between parts that nearly touch). 2: 1 where fit's estimated noise is at least 0.3 % of
      * the bounding-box diagonal, else 3 on clouds of fewer than 20,000 points in which fit
-     * found no thin walls (two sheets in one leaf), else 0. Read
-     * by orient (which solves the smooth implicit) and polygonize (which solves or drops it
-     * if the value changed since). Default 2, range 0..3. */
+     * found no thin walls (two sheets in one leaf), and on clouds of up to 200,000 such points
+     * where the blend's mesh strays from the data (over 0.5 % of its area more than 5 local
+     * sample spacings from every point: a lump past a sparse foot, a bridge), there with the
+     * smooth implicit on a grid twice as coarse and held to within one spacing; else 0. Read
+     * by orient (which makes that test's mesh, handed out by the next polygonize if the blend
+     * stays the surface, and solves the smooth implicit) and polygonize (which tests, solves
+     * or drops them if the value changed since). Default 2, range 0..3. */
     GMPU_PARAM_SURFACE = 14
 } gmpu_param;
 
@@ -233,8 +237,12 @@ typedef enum gmpu_stat {
                                        * mesh's own components may be fewer) */
     GMPU_STAT_FLIPPED_CELLS = 9,      /* leaves whose fitted sign orient reversed */
     GMPU_STAT_FIT_SECONDS = 10,       /* wall time of the last fit */
-    GMPU_STAT_ORIENT_SECONDS = 11,
-    GMPU_STAT_POLYGONIZE_SECONDS = 12,
+    GMPU_STAT_ORIENT_SECONDS = 11,    /* wall time of the last orient; on a dense noise-free
+                                       * cloud orient polygonizes the blend to test it for
+                                       * strays (README), and once polygonize hands that mesh
+                                       * out its time counts as polygonize's instead */
+    GMPU_STAT_POLYGONIZE_SECONDS = 12, /* wall time of the last polygonize, with that of the
+                                        * mesh orient made for it */
     GMPU_STAT_RESOLUTION = 13,        /* grid resolution the last polygonize used */
     GMPU_STAT_BBOX_DIAGONAL = 14,     /* diagonal of the points' bounding box (outliers aside) */
     GMPU_STAT_NOISE = 15,             /* estimated noise σ̂, as a fraction of the diagonal */

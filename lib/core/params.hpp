@@ -12,4 +12,13 @@ struct Params {
 #undef GMPU_PARAM
 };
 
+// Whether every parameter is the same.
+inline bool operator==(const Params &a, const Params &b) {
+#define GMPU_PARAM(KEY, field, ...) \
+    if (!(a.field == b.field)) return false;
+#include "core/param_table.def"
+#undef GMPU_PARAM
+    return true;
+}
+
 }  // namespace gmpu

@@ -1,13 +1,18 @@
 #include "pipeline/reconstruction.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <utility>
 
+#include "core/error.hpp"
 #include "fit/build_octree.hpp"
 #include "fit/noise_estimate.hpp"
 #include "implicit/mpu_function.hpp"
+#include "mesh/confidence.hpp"
 #include "mesh/grid_budget.hpp"
 #include "mesh/polygonizer.hpp"
+#include "pipeline/blend_strays.hpp"
 #include "pipeline/free_sheet.hpp"
 #include "pipeline/smooth_normals.hpp"
 #include "pipeline/smooth_surface.hpp"
@@ -25,6 +30,18 @@ constexpr double kFreeSheetOffset = 2.0;
 void finish(Progress &progress) {
     progress.report(1.0, true);
     progress.throw_if_cancelled();
+}
+
+// The blend's mesh at `resolution`, with its confidence, for the stray test; `seconds`
+// gets the time it took.
+Mesh blend_mesh(const SurfaceField &blend, int resolution, const Params &params, double noise, Workers &workers,
+                Progress &progress, double &seconds) {
+    const auto start = std::chrono::steady_clock::now();
+    Progress march_progress = progress.slice(0.0, 0.95), confidence_progress = progress.slice(0.95, 1.0);
+    Mesh mesh = polygonize(blend, resolution, params, workers, march_progress, noise);
+    compute_confidence(mesh, blend.points(), blend.measures(), workers, confidence_progress);
+    seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return mesh;
 }
 
 }  // namespace
@@ -45,6 +62,9 @@ void Reconstruction::discard_fit() {
     winding = WindingField();
     smooth.reset();
     guide = INFINITY;
+    smooth_kind = SurfaceKind::blend;
+    strays_tested = strays_found = false;
+    tested_mesh = Mesh();
     orient_stats = {};
     blend_grid = smooth_grid = 0;
     thin_walls = false;
@@ -68,13 +88,15 @@ void Reconstruction::fit(const Params &params, Progress &progress) {
 void Reconstruction::orient(const Params &params, Progress &progress) {
     Workers &pool = workers(params.threads);
     progress.report(0.0, true);
+    // Whether the automatic surface depends on the blend's strays: the blend is then tested.
+    const bool test_strays = strays_decide(params, points, noise, thin_walls);
+    const bool may_smooth = test_strays || needs_smooth_field(surface_kind(params, points, noise, thin_walls, false));
     // The steps' shares of the stage's progress.
-    const SurfaceKind kind = surface_kind(params, points, noise, thin_walls);
-    const bool wants_smooth = needs_smooth_field(kind);
-    const double signs_end = wants_smooth ? 0.8 : 0.9, winding_end = wants_smooth ? 0.85 : 1.0;
+    const double signs_end = test_strays ? 0.4 : may_smooth ? 0.8 : 0.9, winding_end = signs_end + (may_smooth ? 0.05 : 0.1),
+                 strays_end = test_strays ? 0.85 : winding_end;
     Progress signs_progress = progress.slice(0.0, signs_end), measures_progress = progress.slice(signs_end, signs_end + 0.05),
              winding_progress = progress.slice(signs_end + 0.05, winding_end),
-             smooth_progress = progress.slice(winding_end, 1.0);
+             strays_progress = progress.slice(winding_end, strays_end), smooth_progress = progress.slice(strays_end, 1.0);
     // The fit is never changed, so a cancelled or failed orient leaves one the next orient
     // can use as it is.
     winding = WindingField();
@@ -87,6 +109,25 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
     const bool noisy_fits = noise >= 0.25 * epsilon;
     measures = measure_points(mpu, points, pool, measures_progress, noisy_fits);
     winding = WindingField(tree, points, measures.blend_normals, measures.area, &winding_progress);
+    // The test's mesh is the one polygonize would make of the blend: at its grid and level.
+    const int resolution = params.resolution > 0 ? params.resolution : blend_resolution();
+    double seconds = 0.0;
+    Mesh mesh;
+    if (test_strays) {
+        try {
+            mesh = blend_mesh(SurfaceField(MpuFunction(tree, orientation.signs, params.level), points, measures,
+                                           winding),
+                              resolution, params, noise, pool, strays_progress, seconds);
+        } catch (const Error &e) {
+            // A mesh over the triangle or memory limits is polygonize's failure to report, as
+            // without the test; the blend stays the surface.
+            if (e.status() != GMPU_ERROR_LIMIT_EXCEEDED) throw;
+        }
+    }
+    const bool strays = test_strays && blend_strays(stray_share(mesh));
+    if (strays) mesh = Mesh();
+    const SurfaceKind kind = surface_kind(params, points, noise, thin_walls, strays);
+    const bool wants_smooth = needs_smooth_field(kind);
     // Noise-limited fits of a thin wall may make one free sheet of it (free_sheet.hpp); the
     // smooth field, not the blend, can make a slab of that.
     if (wants_smooth && noisy_fits &&
@@ -95,9 +136,10 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
         winding = WindingField(tree, points, measures.blend_normals, measures.area, &winding_progress);
     }
     std::shared_ptr<const SmoothField> new_smooth =
-        wants_smooth ? solve_smooth_surface(params, tree, points, measures, noise, pool, smooth_progress) : nullptr;
+        wants_smooth ? solve_smooth_surface(params, kind, tree, points, measures, noise, pool, smooth_progress)
+                     : nullptr;
     // Where the surface is the smooth field, the point normals follow it.
-    if (new_smooth) {
+    if (new_smooth && normals_follow_smooth_field(kind, points)) {
         Progress read_progress = smooth_progress.slice(1.0, 1.0);
         measures.normals = field_point_normals(*new_smooth, points, measures, read_progress);
     }
@@ -105,28 +147,63 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
     smooth_grid = smooth_resolution(tree, measures);
     finish(progress);
     smooth = std::move(new_smooth);
-    guide = kind == SurfaceKind::guided_blend ? guide_limit(measures) : INFINITY;
+    smooth_kind = kind;
+    guide = kind == SurfaceKind::guided_blend ? guide_limit(points, measures) : INFINITY;
+    strays_tested = test_strays;
+    strays_found = strays;
+    tested_mesh = std::move(mesh);
+    tested_resolution = resolution;
+    tested_params = params;
+    tested_seconds = seconds;
     signs = std::move(orientation.signs);
     orient_stats = orientation.stats;
 }
 
-Mesh Reconstruction::polygonize(const Params &params, int resolution, Progress &progress) {
+Mesh Reconstruction::take_tested_mesh(const Params &params, int resolution, double &seconds) {
+    if (tested_mesh.triangles.empty() || resolution != tested_resolution || !(params == tested_params) ||
+        !field_matches(params))
+        return Mesh();
+    seconds = tested_seconds;
+    return std::exchange(tested_mesh, Mesh());
+}
+
+Mesh Reconstruction::polygonize(const Params &params, int resolution, Progress &progress, double *made_at_orient) {
     Workers &pool = workers(params.threads);
     progress.report(0.0, true);
     // The caller checks the mesh and makes the final report.
+    double seconds = 0.0;
+    Mesh kept = take_tested_mesh(params, resolution, seconds);
+    if (made_at_orient) *made_at_orient = kept.triangles.empty() ? 0.0 : seconds;
+    if (!kept.triangles.empty()) return kept;
     if (field_matches(params)) return gmpu::polygonize(field(params.level), resolution, params, pool, progress, noise);
-    // The surface parameter changed since orient: solve or drop the smooth field first.
-    Progress solve_progress = progress.slice(0.0, 0.3), march_progress = progress.slice(0.3, 1.0);
-    const SurfaceKind kind = surface_kind(params, points, noise, thin_walls);
+    // The surface parameter changed since orient: test the blend, solve or drop the smooth
+    // field first.
+    const bool test_strays = !strays_tested && strays_decide(params, points, noise, thin_walls);
+    const double strays_end = test_strays ? 0.7 : 0.0, solve_end = test_strays ? 0.8 : 0.3;
+    Progress strays_progress = progress.slice(0.0, strays_end), solve_progress = progress.slice(strays_end, solve_end),
+             march_progress = progress.slice(solve_end, 1.0);
+    if (test_strays) {
+        const SurfaceField blend(MpuFunction(tree, signs, params.level), points, measures, winding);
+        Mesh mesh = blend_mesh(blend, resolution, params, noise, pool, strays_progress, seconds);
+        strays_tested = true;
+        strays_found = blend_strays(stray_share(mesh));
+        if (!strays_found) {
+            smooth.reset(), smooth_kind = SurfaceKind::blend, guide = INFINITY;
+            return mesh;
+        }
+    }
+    const SurfaceKind kind = surface_for(params);
     if (!needs_smooth_field(kind)) smooth.reset();
-    else if (!smooth) smooth = solve_smooth_surface(params, tree, points, measures, noise, pool, solve_progress);
-    guide = kind == SurfaceKind::guided_blend ? guide_limit(measures) : INFINITY;
+    else if (!smooth || smooth_coarsening(kind, points) != smooth_coarsening(smooth_kind, points))
+        smooth = solve_smooth_surface(params, kind, tree, points, measures, noise, pool, solve_progress);
+    smooth_kind = kind;
+    guide = kind == SurfaceKind::guided_blend ? guide_limit(points, measures) : INFINITY;
     return gmpu::polygonize(field(params.level), resolution, params, pool, march_progress, noise);
 }
 
 int Reconstruction::default_resolution(const Params &params) const {
     // The guided blend's detail is the blend's: its grid too.
-    const bool smooth_grid_wanted = surface_kind(params, points, noise, thin_walls) == SurfaceKind::smooth;
+    const bool smooth_grid_wanted = surface_for(params) == SurfaceKind::smooth;
     if (blend_grid > 0) return smooth_grid_wanted ? smooth_grid : blend_grid;
     return smooth_grid_wanted ? smooth_resolution(tree, measures) : blend_resolution();
 }
@@ -137,10 +214,13 @@ int Reconstruction::blend_resolution() const {
 }
 
 bool Reconstruction::field_matches(const Params &params) const {
+    if (!strays_tested && strays_decide(params, points, noise, thin_walls)) return false;
     const SurfaceKind current = !smooth                 ? SurfaceKind::blend
                                 : std::isfinite(guide) ? SurfaceKind::guided_blend
                                                        : SurfaceKind::smooth;
-    return surface_kind(params, points, noise, thin_walls) == current;
+    const SurfaceKind wanted = surface_for(params);
+    return wanted == current &&
+           (!smooth || smooth_coarsening(wanted, points) == smooth_coarsening(smooth_kind, points));
 }
 
 void Reconstruction::evaluate(const Params &params, const double *xyz, size_t count, double *values,

@@ -22,6 +22,7 @@
 #include "mesh/mesh.hpp"
 #include "model/octree.hpp"
 #include "orient/orient.hpp"
+#include "pipeline/smooth_surface.hpp"
 
 namespace gmpu {
 
@@ -41,6 +42,21 @@ struct Reconstruction {
     // With the smooth field: the limit to which it holds the blend (implicit/guided_blend.hpp),
     // or ∞ where it replaces the blend.
     double guide = INFINITY;
+    // The surface the smooth field was solved for (its grid depends on it: smooth_surface.hpp).
+    SurfaceKind smooth_kind = SurfaceKind::blend;
+    // Whether the blend was tested for strays (pipeline/blend_strays.hpp; only where the
+    // automatic surface depends on it, at orient or polygonize) and found them.
+    bool strays_tested = false, strays_found = false;
+    // The blend's mesh orient made for that test, where the blend stays the surface, with the
+    // grid, parameters and seconds it took: polygonize hands it out when asked for the same
+    // mesh (empty: none kept).
+    Mesh tested_mesh;
+    int tested_resolution = 0;
+    Params tested_params;
+    double tested_seconds = 0.0;
+    // Moves out the kept mesh if it is the one `params` and `resolution` ask for (else an
+    // empty mesh); `seconds` gets the time it took to make.
+    Mesh take_tested_mesh(const Params &params, int resolution, double &seconds);
     OrientStats orient_stats;
     // The default grids of the last orient, blend's and smooth field's: evaluate asks for one
     // on every call, and each is a pass over every cell and point.
@@ -53,9 +69,11 @@ struct Reconstruction {
     // Orient: cell signs, oriented point normals and measures, winding field, and the smooth
     // field when GMPU_PARAM_SURFACE asks for it.
     void orient(const Params &params, Progress &progress);
-    // The mesh of the zero set at `resolution` (polygonizer.hpp: default_resolution). Solves
-    // or drops the smooth field first when GMPU_PARAM_SURFACE changed since orient.
-    Mesh polygonize(const Params &params, int resolution, Progress &progress);
+    // The mesh of the zero set at `resolution` (polygonizer.hpp: default_resolution), the one
+    // orient kept if it is that (take_tested_mesh). Tests the blend, solves or drops the
+    // smooth field first when GMPU_PARAM_SURFACE changed since orient. `made_at_orient` (may
+    // be null) gets the seconds orient spent on the mesh returned (0 when it is made here).
+    Mesh polygonize(const Params &params, int resolution, Progress &progress, double *made_at_orient = nullptr);
     // Polygonize's grid when GMPU_PARAM_RESOLUTION is 0: the smooth field's when `params`
     // asks for it alone, else the blend's (blend_resolution).
     int default_resolution(const Params &params) const;
@@ -79,6 +97,12 @@ struct Reconstruction {
 
     // Forget fit and orient (the points stay).
     void discard_fit();
+
+    // The surface `params` asks for (smooth_surface.hpp: surface_kind), with what is known of
+    // the blend's strays.
+    SurfaceKind surface_for(const Params &params) const {
+        return surface_kind(params, points, noise, thin_walls, strays_found);
+    }
 
     // The worker pool for `threads` (0: one per core): kept across stages, rebuilt only when
     // the count asked for changes.

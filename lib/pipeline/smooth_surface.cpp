@@ -23,12 +23,25 @@ constexpr int kMaxResolution = 1024;
 constexpr double kResolveFromNoise = 0.0075;
 // GMPU_PARAM_SURFACE = 2 guides the blend on noise-free clouds of fewer points than this
 // (unless the fit found thin walls): there leaves hold few points and the blend strays past
-// thin parts' ends; on denser clouds the blend alone is as close, and the smooth solve would
-// cost several times the rest of the run.
+// thin parts' ends. On denser clouds the blend alone is mostly as close, and the smooth
+// solve would cost several times the rest of the run: it is guided only where it strays
+// (blend_strays.hpp).
 constexpr size_t kGuideBelowPoints = 20000;
 // The guided blend's limit, in median sample spacings: enough for the blend's detail
 // (sharp edges, thin walls) to stand, short of its strays.
 constexpr double kGuideSpacings = 0.25;
+// On dense clouds the smooth field that guides is solved on a grid this many times coarser
+// (a third of the time), and the limit widens to a spacing: the strays it must catch lie
+// several spacings out, and the coarser field is a fraction of a spacing off the finer one.
+constexpr int kDenseGuideCoarsening = 2;
+constexpr double kDenseGuideSpacings = 1.0;
+
+// Clouds of more points are not tested for strays: the guiding solve's grid follows the
+// point spacing, and from a few hundred thousand points on it would take several times the
+// rest of the run.
+constexpr size_t kStrayTestBelowPoints = 200000;
+
+bool dense(const PointSet &points) { return points.size() >= kGuideBelowPoints; }
 
 double noise_fraction(const PointSet &points, double noise) {
     const double diagonal = points.world_diagonal() * points.normalisation().scale;  // normalised
@@ -55,23 +68,39 @@ int smooth_resolution(const Octree &tree, const PointMeasures &measures) {
     return std::clamp(std::max(default_resolution(tree, measures), from_spacing), 8, kMaxResolution);
 }
 
-SurfaceKind surface_kind(const Params &params, const PointSet &points, double noise, bool thin_walls) {
+SurfaceKind surface_kind(const Params &params, const PointSet &points, double noise, bool thin_walls,
+                         bool blend_strays) {
     switch (params.surface) {
     case 0: return SurfaceKind::blend;
     case 1: return SurfaceKind::smooth;
     case 3: return SurfaceKind::guided_blend;
     default:
         if (noise_fraction(points, noise) >= kSmoothFromNoise) return SurfaceKind::smooth;
-        return points.size() < kGuideBelowPoints && !thin_walls ? SurfaceKind::guided_blend : SurfaceKind::blend;
+        return !thin_walls && (!dense(points) || blend_strays) ? SurfaceKind::guided_blend : SurfaceKind::blend;
     }
 }
 
-double guide_limit(const PointMeasures &measures) { return kGuideSpacings * median_spacing(measures); }
+bool strays_decide(const Params &params, const PointSet &points, double noise, bool thin_walls) {
+    return points.size() < kStrayTestBelowPoints && surface_kind(params, points, noise, thin_walls, false) !=
+           surface_kind(params, points, noise, thin_walls, true);
+}
 
-std::shared_ptr<const SmoothField> solve_smooth_surface(const Params &params, const Octree &tree,
+double guide_limit(const PointSet &points, const PointMeasures &measures) {
+    return (dense(points) ? kDenseGuideSpacings : kGuideSpacings) * median_spacing(measures);
+}
+
+bool normals_follow_smooth_field(SurfaceKind kind, const PointSet &points) {
+    return kind == SurfaceKind::smooth || (kind == SurfaceKind::guided_blend && !dense(points));
+}
+
+int smooth_coarsening(SurfaceKind kind, const PointSet &points) {
+    return kind == SurfaceKind::guided_blend && dense(points) ? kDenseGuideCoarsening : 1;
+}
+
+std::shared_ptr<const SmoothField> solve_smooth_surface(const Params &params, SurfaceKind kind, const Octree &tree,
                                                         const PointSet &points, const PointMeasures &measures,
                                                         double noise, Workers &workers, Progress &progress) {
-    const double h = 1.0 / smooth_resolution(tree, measures);
+    const double h = double(smooth_coarsening(kind, points)) / smooth_resolution(tree, measures);
     const double noise_share = noise_fraction(points, noise);
     Progress first_progress = progress.slice(0.0, 0.7), normals_progress = progress.slice(0.7, 0.75),
              second_progress = progress.slice(0.75, 1.0);

@@ -2,7 +2,8 @@
 // smooth field solved from the oriented points (1), the blend guided by the smooth field
 // (3, implicit/guided_blend.hpp), or automatically (2, the default): the smooth field where
 // the estimated noise says the blend would follow it, the guided blend on small clouds
-// without thin walls, else the blend.
+// without thin walls and on larger ones (up to a few hundred thousand points) where the
+// blend strays from the data (pipeline/blend_strays.hpp), else the blend.
 #pragma once
 
 #include <memory>
@@ -19,25 +20,43 @@ namespace gmpu {
 enum class SurfaceKind { blend, smooth, guided_blend };
 
 // What `params` asks for, given the fit's estimated noise (normalised units), the points,
-// and whether the fit found thin walls (two sheets closer than the smooth field's grid can
-// keep apart on a sparse cloud: the automatic choice leaves them to the blend).
-SurfaceKind surface_kind(const Params &params, const PointSet &points, double noise, bool thin_walls);
+// whether the fit found thin walls (two sheets closer than the smooth field's grid can
+// keep apart on a sparse cloud: the automatic choice leaves them to the blend), and whether
+// the blend strays from the data (pipeline/blend_strays.hpp; false when not tested).
+SurfaceKind surface_kind(const Params &params, const PointSet &points, double noise, bool thin_walls,
+                         bool blend_strays);
+
+// Whether the answer of surface_kind depends on `blend_strays` (and the cloud is small enough
+// for the test, smooth_surface.cpp): only then is the blend tested.
+bool strays_decide(const Params &params, const PointSet &points, double noise, bool thin_walls);
 
 // Whether that surface needs the smooth field solved.
 inline bool needs_smooth_field(SurfaceKind kind) { return kind != SurfaceKind::blend; }
 
 // How far the guided blend may depart from the smooth field (normalised units): a fraction
-// of the points' median spacing.
-double guide_limit(const PointMeasures &measures);
+// of the points' median spacing on small clouds, a spacing on dense ones (whose smooth
+// field is solved on a coarser grid, solve_smooth_surface).
+double guide_limit(const PointSet &points, const PointMeasures &measures);
 
 // The grid (cubes along the longest side) the smooth field is solved on, and polygonize's
 // default when it is used: the octree's default, refined to the points' spacing.
 int smooth_resolution(const Octree &tree, const PointMeasures &measures);
 
-// The smooth field of an oriented reconstruction, on the grid of smooth_resolution: solved
-// from the blend's normals, then again from its own normals at the points, on `workers`.
-// Reports `progress` to 1.
-std::shared_ptr<const SmoothField> solve_smooth_surface(const Params &params, const Octree &tree,
+// Whether the oriented point normals are the smooth field's (smooth_normals.hpp) for the
+// surface `kind`: for the smooth surface, and for the guided blend on small clouds, where
+// the field's normals are better oriented than the blend's; on dense clouds the blend's are
+// (the coarser guiding field blurs them where parts nearly touch).
+bool normals_follow_smooth_field(SurfaceKind kind, const PointSet &points);
+
+// How many times coarser than smooth_resolution the smooth field of the surface `kind` is
+// solved (1 or kDenseGuideCoarsening, smooth_surface.cpp).
+int smooth_coarsening(SurfaceKind kind, const PointSet &points);
+
+// The smooth field of an oriented reconstruction for the surface `kind`, on the grid of
+// smooth_resolution (half as fine where it guides the blend of a dense cloud: there it only
+// has to catch strays of several spacings): solved from the blend's normals, then again from
+// its own normals at the points at high noise, on `workers`. Reports `progress` to 1.
+std::shared_ptr<const SmoothField> solve_smooth_surface(const Params &params, SurfaceKind kind, const Octree &tree,
                                                         const PointSet &points, const PointMeasures &measures,
                                                         double noise, Workers &workers, Progress &progress);
 

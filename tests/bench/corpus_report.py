@@ -36,9 +36,10 @@ def mesh_name(row):
     return row["mesh"].rsplit(".", 1)[0]
 
 
-def peer_figures_rounded(v):
-    """peers.tsv keeps 4 decimals: compare gmpu at the same precision."""
-    return None if v is None else round(v, 4)
+def peer_figures_rounded(v, row):
+    """peers.tsv keeps 4 decimals: against its figures, compare gmpu at the same precision
+    (live peers' figures are exact, and so is the comparison)."""
+    return None if v is None else round(v, 4) if row.get("peer_source") != "live" else v
 
 
 # ---- the targets, per cloud: None = not judged on this cloud ----
@@ -56,7 +57,7 @@ def checks(row):
     for key, _ in FSCORES:
         v = g.get(key)
         if peer.get(key) is not None:
-            out[key + "_peer"] = v is not None and peer_figures_rounded(v) >= peer[key]
+            out[key + "_peer"] = v is not None and peer_figures_rounded(v, row) >= peer[key]
         if poisson.get(key) is not None:
             out[key + "_poisson"] = v is not None and v >= poisson[key] - POISSON_SLACK
     est = noise_fraction_of_truth(row)

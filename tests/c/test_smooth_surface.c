@@ -139,8 +139,9 @@ static void test_noisy_torus_keeps_its_topology(void **state) {
     free(xyz);
 }
 
-/* Without noise, on 20,000 points and more, the automatic choice keeps the MPU blend: the
- * same values as surface = 0 (fewer points guide it, tests/c/test_guided_blend.cpp). */
+/* Without noise, on 20,000 points and more, the automatic choice keeps the MPU blend where it
+ * keeps to the data, as on this torus: the same values as surface = 0 (fewer points, or a
+ * blend that strays, guide it: tests/c/test_guided_blend.cpp). */
 static void test_clean_cloud_keeps_the_blend(void **state) {
     (void)state;
     double *xyz = noisy_torus(kDenseCloud, 0.0, 3);
