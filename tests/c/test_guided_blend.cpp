@@ -27,18 +27,34 @@ namespace {
 
 // elephant_sparse5k: 5,000 noise-free points of a shape with a trunk, a tail and legs a few
 // sample spacings across.
+// The blend (surface 0) and the surface `params` ask for, from `points`, each compared with
+// `truth` (F at 0.5 % and 1 %).
+struct AgainstBlend {
+    Reconstruction blend, other;
+    SurfaceComparison blend_score, other_score;
+};
+
+AgainstBlend against_blend(const std::vector<Vec3> &points, const TriangleMesh &truth,
+                           const std::vector<std::pair<gmpu_param, double>> &params) {
+    AgainstBlend r;
+    r.blend = reconstruct(points, {{GMPU_PARAM_SURFACE, 0}});
+    r.other = reconstruct(points, params);
+    assert_int_equal(r.blend.status, GMPU_OK);
+    assert_int_equal(r.other.status, GMPU_OK);
+    const ComparisonOptions options{30000, 1, {0.005, 0.01}, 0};
+    r.blend_score = compare_surfaces(r.blend.mesh, truth, options);
+    r.other_score = compare_surfaces(r.other.mesh, truth, options);
+    print_message("blend: precision at 1 %% %.4f, F at 0.5 %% %.4f; other surface: %.4f, %.4f\n",
+                  r.blend_score.fscores[1].precision, r.blend_score.fscores[0].fscore,
+                  r.other_score.fscores[1].precision, r.other_score.fscores[0].fscore);
+    return r;
+}
+
 void guided_blend_ends_thin_parts_with_the_data(void **) {
     const std::vector<Vec3> points = load_points(test_data("clouds/elephant_sparse5k.ply")).positions;
-    const TriangleMesh truth = load_mesh(test_data("meshes/elephant.off"));
-    const ComparisonOptions options{30000, 1, {0.005, 0.01}, 0};
-    Reconstruction blend = reconstruct(points, {{GMPU_PARAM_SURFACE, 0}});
-    Reconstruction guided = reconstruct(points, {{GMPU_PARAM_SURFACE, 3}});
-    assert_int_equal(blend.status, GMPU_OK);
-    assert_int_equal(guided.status, GMPU_OK);
-    const SurfaceComparison b = compare_surfaces(blend.mesh, truth, options);
-    const SurfaceComparison g = compare_surfaces(guided.mesh, truth, options);
-    print_message("blend: precision at 1 %% %.4f, F at 0.5 %% %.4f; guided: %.4f, %.4f\n", b.fscores[1].precision,
-                  b.fscores[0].fscore, g.fscores[1].precision, g.fscores[0].fscore);
+    AgainstBlend r = against_blend(points, load_mesh(test_data("meshes/elephant.off")), {{GMPU_PARAM_SURFACE, 3}});
+    const Reconstruction &guided = r.other;
+    const SurfaceComparison &b = r.blend_score, &g = r.other_score;
     // The blend's strays lie over 1 % of the diagonal from the truth; guided, none does.
     assert_true(b.fscores[1].precision < 0.999);
     assert_true(g.fscores[1].precision > 0.9995);
@@ -69,16 +85,9 @@ bool same_mesh(const TriangleMesh &a, const TriangleMesh &b) {
 
 void dense_cloud_whose_blend_strays_is_guided(void **) {
     const std::vector<Vec3> points = figure_points();
-    const TriangleMesh truth = load_mesh(test_data("corpus/meshes/man.off"));
-    const ComparisonOptions options{30000, 1, {0.005, 0.01}, 0};
-    Reconstruction blend = reconstruct(points, {{GMPU_PARAM_SURFACE, 0}});
-    Reconstruction automatic = reconstruct(points);
-    assert_int_equal(blend.status, GMPU_OK);
-    assert_int_equal(automatic.status, GMPU_OK);
-    const SurfaceComparison b = compare_surfaces(blend.mesh, truth, options);
-    const SurfaceComparison a = compare_surfaces(automatic.mesh, truth, options);
-    print_message("blend: precision at 1 %% %.4f, F at 0.5 %% %.4f; automatic: %.4f, %.4f\n", b.fscores[1].precision,
-                  b.fscores[0].fscore, a.fscores[1].precision, a.fscores[0].fscore);
+    AgainstBlend r = against_blend(points, load_mesh(test_data("corpus/meshes/man.off")), {});
+    const Reconstruction &blend = r.blend, &automatic = r.other;
+    const SurfaceComparison &b = r.blend_score, &a = r.other_score;
     // The blend's lumps lie over 1 % of the diagonal from the truth; guided, next to none.
     assert_true(b.fscores[1].precision < 0.995);
     assert_true(a.fscores[1].precision > 0.999);
