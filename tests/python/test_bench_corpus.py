@@ -41,6 +41,12 @@ def test_fscores_against_the_peer_and_poisson_on_gmpus_normals():
     assert c["fscore_0.5_poisson"] is False
     # peers.tsv keeps 4 decimals: 0.99996 meets a peer's 1.0000
     assert corpus_report.checks(row("bear_clean", fscore_1=0.99996))["fscore_1_peer"] is True
+    # ... but a live peer's figure is exact, and so is the comparison
+    live = row("bear_clean", fscore_1=0.99996)
+    live["peer_source"], live["peer"]["fscore_1"] = "live", 0.99998
+    assert corpus_report.checks(live)["fscore_1_peer"] is False
+    live["peer"]["fscore_1"] = 0.99991
+    assert corpus_report.checks(live)["fscore_1_peer"] is True
 
 
 def test_noise_estimate_is_judged_against_the_truths_diagonal():
