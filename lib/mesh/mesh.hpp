@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 namespace gmpu {
 
 struct Mesh {
@@ -18,5 +20,14 @@ struct Mesh {
     size_t vertex_count() const { return vertices.size() / 3; }
     size_t triangle_count() const { return triangles.size() / 3; }
 };
+
+// Triangle t's (b − a) × (c − a), its corners taken from `vertices` (3 per vertex): along its
+// normal as wound, twice its area long.
+inline Eigen::Vector3d triangle_cross(const std::vector<double> &vertices, const std::vector<uint32_t> &triangles,
+                                      size_t t) {
+    auto at = [&](uint32_t v) { return Eigen::Vector3d(vertices[3 * v], vertices[3 * v + 1], vertices[3 * v + 2]); };
+    const Eigen::Vector3d a = at(triangles[3 * t]);
+    return (at(triangles[3 * t + 1]) - a).cross(at(triangles[3 * t + 2]) - a);
+}
 
 }  // namespace gmpu

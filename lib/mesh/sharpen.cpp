@@ -30,12 +30,6 @@ using Vec = Eigen::Vector3d;
 
 Vec at(const std::vector<double> &xyz, uint32_t v) { return Vec(xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]); }
 
-// Unnormalised normal (twice the area) of triangle t.
-Vec cross_of(const std::vector<double> &xyz, const std::vector<uint32_t> &tri, size_t t) {
-    const Vec a = at(xyz, tri[3 * t]), b = at(xyz, tri[3 * t + 1]), c = at(xyz, tri[3 * t + 2]);
-    return (b - a).cross(c - a);
-}
-
 }  // namespace
 
 size_t sharpen_features(Mesh &mesh, double reach, Progress &progress) {
@@ -126,7 +120,7 @@ size_t sharpen_features(Mesh &mesh, double reach, Progress &progress) {
             if (t % 4096 == 0) progress.poll(0.7);
             const uint32_t *c = &mesh.triangles[3 * t];
             if (!is_moved[c[0]] && !is_moved[c[1]] && !is_moved[c[2]]) continue;
-            const Vec before = cross_of(mesh.vertices, mesh.triangles, t), after = cross_of(moved, mesh.triangles, t);
+            const Vec before = triangle_cross(mesh.vertices, mesh.triangles, t), after = triangle_cross(moved, mesh.triangles, t);
             const double b = before.norm(), a = after.norm();
             if (a >= kMinAreaShare * b && after.dot(before) > cos_turn * a * b) continue;
             for (int k = 0; k < 3; ++k)
@@ -145,7 +139,7 @@ size_t sharpen_features(Mesh &mesh, double reach, Progress &progress) {
         if (t % 4096 == 0) progress.poll(0.9);
         const uint32_t *c = &mesh.triangles[3 * t];
         if (!is_moved[c[0]] && !is_moved[c[1]] && !is_moved[c[2]]) continue;
-        const Vec n = cross_of(moved, mesh.triangles, t);
+        const Vec n = triangle_cross(moved, mesh.triangles, t);
         for (int k = 0; k < 3; ++k)
             for (int d = 0; d < 3; ++d) normal_sum[3 * c[k] + uint32_t(d)] += n[d];
     }

@@ -97,11 +97,10 @@ double bbox_diagonal(const std::vector<double> &xyz) {
 void recompute_normals(Mesh &mesh, const Mesh *fallback) {
     const size_t n = mesh.vertex_count();
     std::vector<Eigen::Vector3d> sum(n, Eigen::Vector3d::Zero());
-    auto at = [&](uint32_t v) { return Eigen::Vector3d(mesh.vertices[3 * v], mesh.vertices[3 * v + 1], mesh.vertices[3 * v + 2]); };
     for (size_t t = 0; t < mesh.triangles.size(); t += 3) {
         const uint32_t a = mesh.triangles[t], b = mesh.triangles[t + 1], c = mesh.triangles[t + 2];
         // The cross product's length is twice the area: the weight.
-        const Eigen::Vector3d w = (at(b) - at(a)).cross(at(c) - at(a));
+        const Eigen::Vector3d w = triangle_cross(mesh.vertices, mesh.triangles, t / 3);
         sum[a] += w, sum[b] += w, sum[c] += w;
     }
     mesh.normals.assign(3 * n, 0.0);

@@ -2,8 +2,6 @@
 
 #include <algorithm>
 
-#include <Eigen/Geometry>
-
 namespace gmpu {
 
 namespace {
@@ -21,10 +19,7 @@ double stray_share(const Mesh &mesh) {
     double area = 0.0, far = 0.0;
     for (size_t t = 0; t < mesh.triangle_count(); ++t) {
         const uint32_t *v = &mesh.triangles[3 * t];
-        using Point = Eigen::Map<const Eigen::Vector3d>;
-        const Point a(&mesh.vertices[3 * size_t(v[0])]), b(&mesh.vertices[3 * size_t(v[1])]),
-            c(&mesh.vertices[3 * size_t(v[2])]);
-        const double piece = 0.5 * Eigen::Vector3d(b - a).cross(Eigen::Vector3d(c - a)).norm();
+        const double piece = 0.5 * triangle_cross(mesh.vertices, mesh.triangles, t).norm();
         area += piece;
         if (std::max({mesh.confidence[v[0]], mesh.confidence[v[1]], mesh.confidence[v[2]]}) > kStrayConfidence)
             far += piece;

@@ -8,7 +8,8 @@
 // the rest of the run for nothing. So orient polygonizes the blend first and measures the
 // share of the mesh's area that lies far from every input point, in units of the local
 // sample spacing (mesh/confidence.hpp). Where the blend stays the surface, polygonize hands
-// that mesh out (pipeline/reconstruction.hpp), so the test costs the confidence alone. The
+// that mesh out with its confidence (pipeline/reconstruction.hpp), so the test adds one pass
+// over the triangles. The
 // caps over an open scan's holes lie as far out: there the smooth field is solved too, and
 // makes about the same caps.
 #pragma once

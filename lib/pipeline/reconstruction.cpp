@@ -215,12 +215,7 @@ int Reconstruction::blend_resolution() const {
 
 bool Reconstruction::field_matches(const Params &params) const {
     if (!strays_tested && strays_decide(params, points, noise, thin_walls)) return false;
-    const SurfaceKind current = !smooth                 ? SurfaceKind::blend
-                                : std::isfinite(guide) ? SurfaceKind::guided_blend
-                                                       : SurfaceKind::smooth;
-    const SurfaceKind wanted = surface_for(params);
-    return wanted == current &&
-           (!smooth || smooth_coarsening(wanted, points) == smooth_coarsening(smooth_kind, points));
+    return surface_for(params) == (smooth ? smooth_kind : SurfaceKind::blend);
 }
 
 void Reconstruction::evaluate(const Params &params, const double *xyz, size_t count, double *values,

@@ -42,7 +42,8 @@ struct Reconstruction {
     // With the smooth field: the limit to which it holds the blend (implicit/guided_blend.hpp),
     // or ∞ where it replaces the blend.
     double guide = INFINITY;
-    // The surface the smooth field was solved for (its grid depends on it: smooth_surface.hpp).
+    // The surface the smooth field was solved for (its grid depends on it: smooth_surface.hpp):
+    // with `smooth`, the surface evaluate and polygonize use (without it, the blend).
     SurfaceKind smooth_kind = SurfaceKind::blend;
     // Whether the blend was tested for strays (pipeline/blend_strays.hpp; only where the
     // automatic surface depends on it, at orient or polygonize) and found them.
