@@ -58,6 +58,19 @@ constexpr double kOuterSteps = 2.0;
 // in the products.
 constexpr double kBytesPerSlotNode = 52, kBytesPerUnknown = 200, kBytesPerPoint = 180;
 
+// The value the zero set is put at among the samples' values (`values` reordered).
+double sample_level(std::vector<double> &values, ZeroLevel level) {
+    if (values.empty()) return 0.0;
+    if (level == ZeroLevel::mean) {
+        double sum = 0.0;
+        for (double v : values) sum += v;
+        return sum / double(values.size());
+    }
+    const auto middle = values.begin() + long(values.size() / 2);
+    std::nth_element(values.begin(), middle, values.end());
+    return *middle;
+}
+
 double weight(double d2, double r2) {
     const double t = 1.0 - d2 / r2;
     return t > 0.0 ? t * t : 0.0;
@@ -73,15 +86,17 @@ int32_t SmoothField::node(int64_t x, int64_t y, int64_t z) const {
 }
 
 SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, double spacing, double min_trust,
-                         double noise, double max_memory, Workers &workers, Progress &progress) {
+                         double noise, ZeroLevel zero_level, double max_memory, Workers &workers, Progress &progress) {
     if (points.size() == 0) return;
     max_reach_ = kMaxReachSteps * spacing;
+    level_ = zero_level;
     {
         // The fine band takes more memory than the coarser bands: laid out first, its memory
         // check fails a cloud too scattered for the budget before the outer field and the
         // coarser bands are solved for nothing.
         SmoothField fine;
         fine.h_ = spacing;
+        fine.level_ = zero_level;
         fine.max_reach_ = max_reach_;
         Progress layout_progress = progress.slice(0.0, 0.0);
         fine.lay_out(points, measures, min_trust, false, max_memory, layout_progress);
@@ -90,6 +105,7 @@ SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, 
     auto outer = std::make_shared<SmoothField>();
     outer->h_ = kOuterSteps * spacing;
     outer->max_reach_ = max_reach_;
+    outer->level_ = zero_level;
     Progress outer_progress = progress.slice(0.0, 0.1);
     outer->solve(points, measures, measures.blend_normals, min_trust, noise, max_memory, nullptr, nullptr, true,
                  kOuterIterations, workers, outer_progress);
@@ -103,6 +119,7 @@ SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, 
         SmoothField level;
         level.h_ = steps[l];
         level.max_reach_ = max_reach_;
+        level.level_ = level_;
         Progress slice = progress.slice(0.1 + (levels - 1 - double(l)) / levels * 0.1,
                                         0.1 + (levels - double(l)) / levels * 0.1);
         level.solve(points, measures, measures.blend_normals, min_trust, noise, max_memory, coarse.empty() ? nullptr : &coarse,
@@ -128,12 +145,14 @@ SmoothField SmoothField::resolved(const PointSet &points, const PointMeasures &m
     next.h_ = h_;
     next.min_trust_ = min_trust_;
     next.max_reach_ = max_reach_;
+    next.level_ = level_;
     // The outer field first: it holds the band's edge, and a misoriented patch's error lives
     // in it as much as in the band (kept, the old outer field would pin the band's edge to
     // the old normals' surface). Both start from the previous solution.
     auto outer = std::make_shared<SmoothField>();
     outer->h_ = outer_->h_;
     outer->max_reach_ = max_reach_;
+    outer->level_ = level_;
     Progress outer_progress = progress.slice(0.0, 0.3);
     outer->solve(points, measures, normals, min_trust_, noise, max_memory, outer_.get(), nullptr, true, kOuterIterations,
                  workers, outer_progress);
@@ -508,17 +527,17 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
         });
         rz_rr = next;
     }
-    // The zero set through the samples on average: with weak screening the normals' integral
-    // alone fixes f up to an offset, which would shrink or swell the whole surface.
-    double at_samples = 0.0, count = 0.0;
+    // The zero set through the samples (ZeroLevel): with weak screening the normals'
+    // integral alone fixes f up to an offset, which would shrink or swell the whole surface.
+    std::vector<double> at_samples;
+    at_samples.reserve(n);
     for (size_t i = 0; i < n; ++i) {
         if (sample_scale[i] == 0.0) continue;
         double at = 0.0;
         for (int k = 0; k < 8; ++k) at += sample_weight[8 * i + size_t(k)] * x[sample_node[8 * i + size_t(k)]];
-        at_samples += at;
-        count += 1.0;
+        at_samples.push_back(at);
     }
-    const double shift = count > 0.0 ? at_samples / count : 0.0;
+    const double shift = sample_level(at_samples, level_);
     x.array() -= shift;
     values_.assign(x.data(), x.data() + unknowns);
     progress.report(1.0);

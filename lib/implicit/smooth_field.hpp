@@ -10,9 +10,10 @@
 // where V is the splatted field of the inward normals (unit where they agree; within a few
 // grid steps of the points, 0 farther) and the
 // screening term pulls the zero set through the points, all weighted alike (Aᵢ: their mean
-// area), with α falling as the estimated noise grows; f is then shifted so that its mean
-// over the samples is 0. The gradient term couples every sample to its neighbours, so a point's noise
-// is averaged over its neighbourhood instead of bending the surface; the normals, which
+// area), with α falling as the estimated noise grows; f is then shifted so that its median
+// over the samples is 0 (its mean, beside thin walls: ZeroLevel). The gradient term
+// couples every sample to its neighbours, so a point's noise is averaged over its
+// neighbourhood instead of bending the surface; the normals, which
 // belief propagation made consistent, set the shape. f is about a signed distance,
 // positive inside like the MPU blend. Values between grid nodes are trilinear; gradients
 // are central differences at the nodes, interpolated the same way.
@@ -47,16 +48,27 @@ namespace gmpu {
 
 struct PointMeasures;
 
+// How f's offset is set once the normals' integral is solved: the zero set through the
+// samples' median value or through their mean. At noise, on a part thinner than a few σ, a
+// sample pushed outward has f the more negative the farther it lies, while one pushed
+// inward past the part's middle has f fall again: the samples' values have a long negative
+// tail. Through their mean the zero set moves outward to balance that tail, and every thin
+// part comes out too thick; the median is not moved by it. Where the fit found thin walls
+// (two sheets in one support) the median let the sheets approach until they touched, and
+// the mean keeps them apart (pipeline/smooth_surface.cpp chooses).
+enum class ZeroLevel { median, mean };
+
 class SmoothField {
 public:
     SmoothField() = default;
     // `spacing`: the grid step (normalised frame); `min_trust` widens every point's trust
     // radius for the band; `noise`: the fit's estimated noise deviation as a fraction of the
     // bounding-box diagonal (0 if none), which sets how hard the surface is pulled through
-    // each sample. Checks its memory estimate against `max_memory` (LIMIT_EXCEEDED) and
-    // polls `progress`, which it reports to 1.
+    // each sample; `level`: where the zero set lies among the samples. Checks its memory
+    // estimate against `max_memory` (LIMIT_EXCEEDED) and polls `progress`, which it reports
+    // to 1.
     SmoothField(const PointSet &points, const PointMeasures &measures, double spacing, double min_trust, double noise,
-                double max_memory, Workers &workers, Progress &progress);
+                ZeroLevel level, double max_memory, Workers &workers, Progress &progress);
 
     // f and optionally ∇f at x: the band's where it is defined, else the outer field's;
     // false outside the outer field's box (f is then undefined).
@@ -73,7 +85,7 @@ public:
 
 private:
     static constexpr int B = 8;  // nodes per block side of the sparse storage
-    // Returns the shift that made f's mean over the samples 0. `boundary` (may be null) gives
+    // Returns the shift that made f's median (or mean, level_) over the samples 0. `boundary` (may be null) gives
     // the band's edge its values; `whole_box` solves on every node of the box, not a band.
     double solve(const PointSet &points, const PointMeasures &measures, const std::vector<float> &normals,
                  double min_trust, double noise, double max_memory, const SmoothField *coarse,
@@ -95,6 +107,7 @@ private:
     double h_ = 0.0;
     double min_trust_ = 0.0;
     double max_reach_ = 0.0;          // the longest splat radius, before the cell diagonal
+    ZeroLevel level_ = ZeroLevel::median;
     int64_t nodes_[3] = {0, 0, 0};     // per axis
     int64_t blocks_[3] = {0, 0, 0};    // per axis
     std::vector<int32_t> block_slot_;  // per block: its slot in node_index_ (÷ B³), or -1

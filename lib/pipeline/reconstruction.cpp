@@ -136,8 +136,9 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
         winding = WindingField(tree, points, measures.blend_normals, measures.area, &winding_progress);
     }
     std::shared_ptr<const SmoothField> new_smooth =
-        wants_smooth ? solve_smooth_surface(params, kind, tree, points, measures, noise, pool, smooth_progress)
-                     : nullptr;
+        wants_smooth
+            ? solve_smooth_surface(params, kind, tree, points, measures, noise, thin_walls, pool, smooth_progress)
+            : nullptr;
     // Where the surface is the smooth field, the point normals follow it.
     if (new_smooth && normals_follow_smooth_field(kind, points)) {
         Progress read_progress = smooth_progress.slice(1.0, 1.0);
@@ -195,7 +196,7 @@ Mesh Reconstruction::polygonize(const Params &params, int resolution, Progress &
     const SurfaceKind kind = surface_for(params);
     if (!needs_smooth_field(kind)) smooth.reset();
     else if (!smooth || smooth_coarsening(kind, points) != smooth_coarsening(smooth_kind, points))
-        smooth = solve_smooth_surface(params, kind, tree, points, measures, noise, pool, solve_progress);
+        smooth = solve_smooth_surface(params, kind, tree, points, measures, noise, thin_walls, pool, solve_progress);
     smooth_kind = kind;
     guide = kind == SurfaceKind::guided_blend ? guide_limit(points, measures) : INFINITY;
     return gmpu::polygonize(field(params.level), resolution, params, pool, march_progress, noise);

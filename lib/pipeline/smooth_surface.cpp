@@ -99,12 +99,14 @@ int smooth_coarsening(SurfaceKind kind, const PointSet &points) {
 
 std::shared_ptr<const SmoothField> solve_smooth_surface(const Params &params, SurfaceKind kind, const Octree &tree,
                                                         const PointSet &points, const PointMeasures &measures,
-                                                        double noise, Workers &workers, Progress &progress) {
+                                                        double noise, bool thin_walls, Workers &workers,
+                                                        Progress &progress) {
     const double h = double(smooth_coarsening(kind, points)) / smooth_resolution(tree, measures);
+    const ZeroLevel level = thin_walls ? ZeroLevel::mean : ZeroLevel::median;
     const double noise_share = noise_fraction(points, noise);
     Progress first_progress = progress.slice(0.0, 0.7), normals_progress = progress.slice(0.7, 0.75),
              second_progress = progress.slice(0.75, 1.0);
-    SmoothField first(points, measures, h, 2.0 * h, noise_share, params.max_memory, workers, first_progress);
+    SmoothField first(points, measures, h, 2.0 * h, noise_share, level, params.max_memory, workers, first_progress);
     // Solved again from its own normals at the points (where the neighbours agree): they
     // are the blend's normals averaged over the field's neighbourhood, far less noisy than
     // the blend's own at noise, and scattered flips are corrected.

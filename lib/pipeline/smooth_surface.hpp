@@ -55,9 +55,12 @@ int smooth_coarsening(SurfaceKind kind, const PointSet &points);
 // The smooth field of an oriented reconstruction for the surface `kind`, on the grid of
 // smooth_resolution (half as fine where it guides the blend of a dense cloud: there it only
 // has to catch strays of several spacings): solved from the blend's normals, then again from
-// its own normals at the points at high noise, on `workers`. Reports `progress` to 1.
+// its own normals at the points at high noise, on `workers`. Its zero set lies at the
+// samples' median value, or at their mean where the fit found `thin_walls` (ZeroLevel).
+// Reports `progress` to 1.
 std::shared_ptr<const SmoothField> solve_smooth_surface(const Params &params, SurfaceKind kind, const Octree &tree,
                                                         const PointSet &points, const PointMeasures &measures,
-                                                        double noise, Workers &workers, Progress &progress);
+                                                        double noise, bool thin_walls, Workers &workers,
+                                                        Progress &progress);
 
 }  // namespace gmpu

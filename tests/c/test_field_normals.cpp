@@ -90,7 +90,7 @@ void isolated_flips_follow_the_field(void **) {
     Progress quiet(nullptr, nullptr, GMPU_STAGE_ORIENT);
     Workers workers(2);
     const double h = 1.0 / 64;
-    const SmoothField field(points, measures, h, 2.0 * h, 0.005, 1e9, workers, quiet);
+    const SmoothField field(points, measures, h, 2.0 * h, 0.005, ZeroLevel::median, 1e9, workers, quiet);
     const std::vector<float> out = field_point_normals(field, points, measures, quiet);
     size_t corrected = 0, right = 0;
     for (size_t i = 0; i < points.size(); ++i) {
@@ -125,7 +125,7 @@ void thin_wall_keeps_its_normals(void **) {
     Progress quiet(nullptr, nullptr, GMPU_STAGE_ORIENT);
     Workers workers(2);
     const double h = 1.0 / 128;
-    const SmoothField field(points, measures, h, 2.0 * h, 0.002, 1e9, workers, quiet);
+    const SmoothField field(points, measures, h, 2.0 * h, 0.002, ZeroLevel::median, 1e9, workers, quiet);
     const std::vector<float> out = field_point_normals(field, points, measures, quiet);
     size_t right = 0;
     for (size_t i = 0; i < n; ++i) right += dot(out, normals, i) > 0.0;
