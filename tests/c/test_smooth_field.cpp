@@ -50,6 +50,21 @@ struct Cloud {
     double radius, sigma;
 };
 
+// The measures the field reads, as orient leaves them: the `outward` normals, a trust
+// radius of 1.5 × the 9th-neighbour distance, every point standing for `area`.
+void measure(Cloud &c, const std::vector<Vector3d> &outward, double area) {
+    std::vector<uint32_t> idx;
+    std::vector<float> d2;
+    for (size_t i = 0; i < c.points.size(); ++i) {
+        for (int k = 0; k < 3; ++k) c.measures.blend_normals.push_back(float(outward[i][k]));
+        c.points.nearest(c.points.point(i), 9, idx, d2);
+        c.measures.trust_radius.push_back(float(1.5 * std::sqrt(double(d2.back()))));
+        c.measures.widest_trust = std::max(c.measures.widest_trust, double(c.measures.trust_radius.back()));
+        c.measures.area.push_back(float(area));
+    }
+    c.measures.normals = c.measures.blend_normals;
+}
+
 // Points on the unit sphere with noise of 1 % of the diagonal along the normal; the
 // oriented normals point inward on `misoriented` of the cap z > kCapFrom.
 Cloud misoriented_cap_sphere(double misoriented = kMisoriented) {
@@ -73,17 +88,7 @@ Cloud misoriented_cap_sphere(double misoriented = kMisoriented) {
     c.radius = 0.5 * (c.points.box_max() - c.points.box_min()).maxCoeff() / (1.0 + 3.0 * sigma);
     c.sigma = sigma * c.radius;
 
-    std::vector<uint32_t> idx;
-    std::vector<float> d2;
-    const double area = 4.0 * M_PI * c.radius * c.radius / double(kPoints);
-    for (size_t i = 0; i < kPoints; ++i) {
-        for (int k = 0; k < 3; ++k) c.measures.blend_normals.push_back(float(outward[i][k]));
-        c.points.nearest(c.points.point(i), 9, idx, d2);
-        c.measures.trust_radius.push_back(float(1.5 * std::sqrt(double(d2.back()))));
-        c.measures.widest_trust = std::max(c.measures.widest_trust, double(c.measures.trust_radius.back()));
-        c.measures.area.push_back(float(area));
-    }
-    c.measures.normals = c.measures.blend_normals;
+    measure(c, outward, 4.0 * M_PI * c.radius * c.radius / double(kPoints));
     return c;
 }
 
@@ -265,17 +270,7 @@ Cloud noisy_ring() {
     c.centre = c.points.normalisation().to_unit(Vector3d::Zero());
     c.radius = scale;
     c.sigma = kTubeNoise * scale;
-    std::vector<uint32_t> idx;
-    std::vector<float> d2;
-    const double area = 4.0 * M_PI * M_PI * kRing * kTube * scale * scale / double(n);
-    for (size_t i = 0; i < n; ++i) {
-        for (int k = 0; k < 3; ++k) c.measures.blend_normals.push_back(float(outward[i][k]));
-        c.points.nearest(c.points.point(i), 9, idx, d2);
-        c.measures.trust_radius.push_back(float(1.5 * std::sqrt(double(d2.back()))));
-        c.measures.widest_trust = std::max(c.measures.widest_trust, double(c.measures.trust_radius.back()));
-        c.measures.area.push_back(float(area));
-    }
-    c.measures.normals = c.measures.blend_normals;
+    measure(c, outward, 4.0 * M_PI * M_PI * kRing * kTube * scale * scale / double(n));
     return c;
 }
 
