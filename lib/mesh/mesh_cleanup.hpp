@@ -1,5 +1,5 @@
-// Removing whole closed components keeps a watertight mesh watertight: the one clean-up
-// the polygonizer does.
+// Removing whole closed components keeps a watertight mesh watertight: the clean-up the
+// polygonizer does.
 #pragma once
 
 #include <cstdint>
@@ -18,5 +18,10 @@ uint32_t vertex_components(const Mesh &mesh, std::vector<uint32_t> &component, P
 // in total (votes: one count per vertex), and compacts the vertex arrays.
 void remove_unsupported_components(Mesh &mesh, const std::vector<uint32_t> &votes, uint32_t min_votes,
                                    Progress &progress);
+
+// Drops every connected component that fits in an axis-aligned cube of side `min_side`
+// (its bounding box's longest side is shorter), except the one with the most vertices (a
+// mesh is never emptied), and compacts the vertex arrays.
+void remove_components_smaller_than(Mesh &mesh, double min_side, Progress &progress);
 
 }  // namespace gmpu

@@ -25,6 +25,10 @@ constexpr int B = BlockGrid::B;
 // to be kept: a real part holds at least the N_min (15) points one local fit needs; a
 // bubble of the far field or a stray quadric sheet holds none or a few noisy ones.
 constexpr uint32_t kMinVotes = 15;
+// A closed piece that fits in a box this many cubes on a side is dropped beside a larger
+// one: it encloses one or two grid corners of the other sign, a pocket the grid cannot
+// resolve (the field's sign flipped there by the noise, or in a crevice where parts touch).
+constexpr double kGridScalePiece = 2.0;
 // Grid cube as a share of the gap between two sheets fitted in one leaf.
 constexpr double kCubesPerGap = 0.4;
 // Share of the points that two-sheet leaves must hold for their gap to set the grid.
@@ -307,6 +311,7 @@ Mesh polygonize(const SurfaceField &field, int resolution, const Params &params,
     Mesh mesh = weld(blocks, points.normalisation(), weld_progress, votes);
     progress.throw_if_cancelled();
     remove_unsupported_components(mesh, votes, kMinVotes, cleanup_progress);
+    remove_components_smaller_than(mesh, kGridScalePiece * h / points.normalisation().scale, cleanup_progress);
     if (clean) sharpen_features(mesh, kSharpenReach * h / points.normalisation().scale, sharpen_progress);
     // A grid the caller chose keeps all its triangles.
     if (params.resolution == 0) cap_mesh_size(mesh, points.size(), kCapErrorShare * params.error, workers, cap_progress);

@@ -798,6 +798,34 @@ void unsupported_components_are_dropped(void **) {
     for (uint32_t t : m.triangles) assert_true(t < 4);
 }
 
+void pieces_smaller_than_a_side_are_dropped(void **) {
+    // Tetrahedra of sides 3, 0.5 and 1.5: with a minimum side of 1 the small one goes.
+    auto add_tetrahedron = [](Mesh &m, double x, double side) {
+        const uint32_t b = uint32_t(m.vertex_count());
+        m.vertices.insert(m.vertices.end(), {x, 0, 0, x + side, 0, 0, x, side, 0, x, 0, side});
+        m.triangles.insert(m.triangles.end(), {b, b + 2, b + 1, b, b + 1, b + 3, b, b + 3, b + 2, b + 1, b + 2, b + 3});
+    };
+    Mesh m;
+    add_tetrahedron(m, 0, 3);
+    add_tetrahedron(m, 10, 0.5);
+    add_tetrahedron(m, 20, 1.5);
+    Progress quiet(nullptr, nullptr, GMPU_STAGE_POLYGONIZE);
+    remove_components_smaller_than(m, 1.0, quiet);
+    assert_int_equal(m.vertex_count(), 8);
+    assert_int_equal(m.triangle_count(), 8);
+    assert_near(m.vertices[12], 20.0, 0);
+    for (uint32_t t : m.triangles) assert_true(t < 8);
+    // Every piece under the side: the largest (most vertices) stays, the mesh is never emptied.
+    Mesh tiny;
+    add_tetrahedron(tiny, 0, 0.2);
+    add_tetrahedron(tiny, 5, 0.1);
+    tiny.vertices.insert(tiny.vertices.end(), {5.05, 0.05, 0.05});  // an extra vertex in the second
+    tiny.triangles.insert(tiny.triangles.end(), {4, 5, 8});
+    remove_components_smaller_than(tiny, 1.0, quiet);
+    assert_int_equal(tiny.vertex_count(), 5);
+    assert_near(tiny.vertices[0], 5.0, 0);
+}
+
 // ---- parallel loop ------------------------------------------------------------------------
 
 void parallel_for_runs_each_index_once(void **) {
@@ -991,6 +1019,7 @@ int main(void) {
         cmocka_unit_test(marching_cubes_keep_a_thin_solid_whole),
         cmocka_unit_test(marching_cubes_sphere_needs_few_triangles),
         cmocka_unit_test(unsupported_components_are_dropped),
+        cmocka_unit_test(pieces_smaller_than_a_side_are_dropped),
         cmocka_unit_test(parallel_for_runs_each_index_once),
         cmocka_unit_test(parallel_for_rethrows_and_cancels),
         cmocka_unit_test(only_the_final_report_says_done),

@@ -234,6 +234,27 @@ void islands(void **) {
     assert_true(f[0] > 0 && f[1] > 0 && f[2] > 0 && f[3] < 0 && f[4] < 0);
 }
 
+// A tight cluster of 40 points off a sphere, 0.07 across: at the default grid (about 1.5
+// cubes across) it encloses a corner or two and would be a closed piece the grid cannot
+// resolve, which is dropped; on a grid 2× finer (about 3 cubes) it is a piece of its own.
+void grid_scale_pieces_are_dropped(void **) {
+    Sphere big({0, 0, 0}, 1.0), cluster({1.2, 0, 0}, 0.035);
+    std::vector<Vec3> pts = big.sample(20000, 1).positions;
+    const std::vector<Vec3> small = cluster.sample(40, 2).positions;
+    pts.insert(pts.end(), small.begin(), small.end());
+    Reconstruction coarse = reconstruct(pts);
+    assert_int_equal(coarse.status, GMPU_OK);
+    MeshCheck check = check_mesh(coarse.mesh);
+    assert_true(check.watertight);
+    assert_int_equal(check.components, 1);
+    const double resolution = coarse.stat(GMPU_STAT_RESOLUTION);
+    Reconstruction fine = reconstruct(pts, {{GMPU_PARAM_RESOLUTION, 2 * resolution}});
+    assert_int_equal(fine.status, GMPU_OK);
+    check = check_mesh(fine.mesh);
+    assert_true(check.watertight);
+    assert_int_equal(check.components, 2);
+}
+
 void scale_invariance(void **) {
     // The same sphere at 1e-6 and 1e6 scale (and far from the origin) gives the same mesh
     // up to the scale: everything works in a normalised frame.
@@ -447,6 +468,7 @@ int main(void) {
         cmocka_unit_test(thin_torus),
         cmocka_unit_test(cube),
         cmocka_unit_test(islands),
+        cmocka_unit_test(grid_scale_pieces_are_dropped),
         cmocka_unit_test(scale_invariance),
         cmocka_unit_test(input_normals_decide_the_sign),
         cmocka_unit_test(level_of_detail),
