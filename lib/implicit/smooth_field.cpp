@@ -86,26 +86,20 @@ int32_t SmoothField::node(int64_t x, int64_t y, int64_t z) const {
 }
 
 SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, double spacing, double min_trust,
-                         double noise, ZeroLevel zero_level, double max_memory, Workers &workers, Progress &progress) {
+                         double noise, ZeroLevel level, double max_memory, Workers &workers, Progress &progress) {
     if (points.size() == 0) return;
     max_reach_ = kMaxReachSteps * spacing;
-    level_ = zero_level;
+    level_ = level;
     {
         // The fine band takes more memory than the coarser bands: laid out first, its memory
         // check fails a cloud too scattered for the budget before the outer field and the
         // coarser bands are solved for nothing.
-        SmoothField fine;
-        fine.h_ = spacing;
-        fine.level_ = zero_level;
-        fine.max_reach_ = max_reach_;
+        SmoothField fine = with_step(spacing);
         Progress layout_progress = progress.slice(0.0, 0.0);
         fine.lay_out(points, measures, min_trust, false, max_memory, layout_progress);
     }
     // The outer field: the same problem on a coarser grid over the whole box, solved first.
-    auto outer = std::make_shared<SmoothField>();
-    outer->h_ = kOuterSteps * spacing;
-    outer->max_reach_ = max_reach_;
-    outer->level_ = zero_level;
+    auto outer = std::make_shared<SmoothField>(with_step(kOuterSteps * spacing));
     Progress outer_progress = progress.slice(0.0, 0.1);
     outer->solve(points, measures, measures.blend_normals, min_trust, noise, max_memory, nullptr, nullptr, true,
                  kOuterIterations, workers, outer_progress);
@@ -116,15 +110,12 @@ SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, 
     SmoothField coarse;
     const double levels = double(steps.size());
     for (size_t l = steps.size(); l-- > 1;) {
-        SmoothField level;
-        level.h_ = steps[l];
-        level.max_reach_ = max_reach_;
-        level.level_ = level_;
+        SmoothField coarser = with_step(steps[l]);
         Progress slice = progress.slice(0.1 + (levels - 1 - double(l)) / levels * 0.1,
                                         0.1 + (levels - double(l)) / levels * 0.1);
-        level.solve(points, measures, measures.blend_normals, min_trust, noise, max_memory, coarse.empty() ? nullptr : &coarse,
-                    outer.get(), false, kMaxIterations, workers, slice);
-        coarse = std::move(level);
+        coarser.solve(points, measures, measures.blend_normals, min_trust, noise, max_memory,
+                      coarse.empty() ? nullptr : &coarse, outer.get(), false, kMaxIterations, workers, slice);
+        coarse = std::move(coarser);
     }
     h_ = spacing;
     Progress fine = progress.slice(steps.size() > 1 ? 0.2 : 0.0, 1.0);
@@ -137,22 +128,24 @@ SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, 
     min_trust_ = min_trust;
 }
 
+SmoothField SmoothField::with_step(double step) const {
+    SmoothField field;
+    field.h_ = step;
+    field.max_reach_ = max_reach_;
+    field.level_ = level_;
+    return field;
+}
+
 SmoothField SmoothField::resolved(const PointSet &points, const PointMeasures &measures,
                                   const std::vector<float> &normals, double noise, double max_memory,
                                   Workers &workers, Progress &progress) const {
-    SmoothField next;
-    if (empty()) return next;
-    next.h_ = h_;
+    if (empty()) return SmoothField();
+    SmoothField next = with_step(h_);
     next.min_trust_ = min_trust_;
-    next.max_reach_ = max_reach_;
-    next.level_ = level_;
     // The outer field first: it holds the band's edge, and a misoriented patch's error lives
     // in it as much as in the band (kept, the old outer field would pin the band's edge to
     // the old normals' surface). Both start from the previous solution.
-    auto outer = std::make_shared<SmoothField>();
-    outer->h_ = outer_->h_;
-    outer->max_reach_ = max_reach_;
-    outer->level_ = level_;
+    auto outer = std::make_shared<SmoothField>(with_step(outer_->h_));
     Progress outer_progress = progress.slice(0.0, 0.3);
     outer->solve(points, measures, normals, min_trust_, noise, max_memory, outer_.get(), nullptr, true, kOuterIterations,
                  workers, outer_progress);

@@ -85,8 +85,12 @@ public:
 
 private:
     static constexpr int B = 8;  // nodes per block side of the sparse storage
-    // Returns the shift that made f's median (or mean, level_) over the samples 0. `boundary` (may be null) gives
-    // the band's edge its values; `whole_box` solves on every node of the box, not a band.
+    // An empty field on a grid of step `step` with this one's splat reach and zero level:
+    // the outer field and the cascade's levels.
+    SmoothField with_step(double step) const;
+    // Returns the shift that made f's median (or mean, level_) over the samples 0. `boundary`
+    // (may be null) gives the band's edge its values; `whole_box` solves on every node of
+    // the box, not a band.
     double solve(const PointSet &points, const PointMeasures &measures, const std::vector<float> &normals,
                  double min_trust, double noise, double max_memory, const SmoothField *coarse,
                  const SmoothField *boundary, bool whole_box, int iterations, Workers &workers, Progress &progress);
