@@ -51,12 +51,21 @@ constexpr double kNormalReachSteps = 3.0;
 // The outer field's grid step, in fine steps: coarse enough to cover the whole box at a
 // small cost, fine enough to keep a thin wall's two sides apart where it hands over.
 constexpr double kOuterSteps = 2.0;
+// The local zero level (follow_local_level): cells of this many grid steps, each with at
+// least kLevelCellSamples samples; a cell's correction is the samples' median value less
+// kLevelMedianErrors standard errors of that median (1.2533 σ̂ / √n for n normal draws), so
+// that the noise alone seldom moves f, and at most kLevelMaxSteps grid steps. Larger cells
+// or a smaller margin follow the noise on smooth parts; smaller cells or a larger margin
+// leave the rounded features as they were.
+constexpr double kLevelCellSteps = 4.0, kLevelMedianErrors = 1.25, kLevelMaxSteps = 1.0;
+constexpr size_t kLevelCellSamples = 12;
+constexpr double kMedianError = 1.2533;
 // Memory model, for GMPU_PARAM_MAX_MEMORY: per node of a touched block, the splat's sums
 // (weight, distance, the normals' weight and sum) and its index; per unknown, the field,
 // its six neighbours, its row's start and the solver's vectors; per point, its 8 trilinear weights and nodes,
 // its entries in the blocks' and the rows' lists (about 8 blocks, 8 corners) and its value
-// in the products.
-constexpr double kBytesPerSlotNode = 52, kBytesPerUnknown = 200, kBytesPerPoint = 180;
+// in the products, its cell and value for the local zero level.
+constexpr double kBytesPerSlotNode = 52, kBytesPerUnknown = 200, kBytesPerPoint = 192;
 
 // The value the zero set is put at among the samples' values (`values` reordered).
 double sample_level(std::vector<double> &values, ZeroLevel level) {
@@ -86,10 +95,12 @@ int32_t SmoothField::node(int64_t x, int64_t y, int64_t z) const {
 }
 
 SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, double spacing, double min_trust,
-                         double noise, ZeroLevel level, double max_memory, Workers &workers, Progress &progress) {
+                         double noise, ZeroLevel level, double max_memory, Workers &workers, Progress &progress,
+                         LocalLevel local) {
     if (points.size() == 0) return;
     max_reach_ = kMaxReachSteps * spacing;
     level_ = level;
+    local_ = local;
     {
         // The fine band takes more memory than the coarser bands: laid out first, its memory
         // check fails a cloud too scattered for the budget before the outer field and the
@@ -133,6 +144,7 @@ SmoothField SmoothField::with_step(double step) const {
     field.h_ = step;
     field.max_reach_ = max_reach_;
     field.level_ = level_;
+    field.local_ = local_;
     return field;
 }
 
@@ -532,9 +544,85 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
     }
     const double shift = sample_level(at_samples, level_);
     x.array() -= shift;
+    if (!whole_box && local_ == LocalLevel::follow) follow_local_level(points, sample_node, sample_weight, sample_scale, noise, x, workers, progress);
     values_.assign(x.data(), x.data() + unknowns);
     progress.report(1.0);
     return shift;
+}
+
+void SmoothField::follow_local_level(const PointSet &points, const std::vector<int32_t> &sample_node,
+                                     const std::vector<double> &sample_weight, const std::vector<double> &sample_scale,
+                                     double noise, Eigen::VectorXd &x, Workers &workers, Progress &progress) {
+    const double cell = kLevelCellSteps * h_;
+    int64_t cells[3];
+    for (int d = 0; d < 3; ++d) cells[d] = int64_t(std::ceil(double(nodes_[d]) * h_ / cell)) + 1;
+    auto cell_of = [&](const Eigen::Vector3d &q) {
+        const Eigen::Vector3d t = (q - origin_) / cell;
+        const int64_t c[3] = {std::clamp(int64_t(std::floor(t[0])), int64_t(0), cells[0] - 1),
+                              std::clamp(int64_t(std::floor(t[1])), int64_t(0), cells[1] - 1),
+                              std::clamp(int64_t(std::floor(t[2])), int64_t(0), cells[2] - 1)};
+        return size_t(c[0] + cells[0] * (c[1] + cells[1] * c[2]));
+    };
+    // The samples' values by cell (a counting sort: cells hold their samples contiguously).
+    const size_t n = points.size(), cell_count = size_t(cells[0] * cells[1] * cells[2]);
+    std::vector<uint32_t> start(cell_count + 1, 0);
+    std::vector<uint32_t> cell_of_sample(n, UINT32_MAX);
+    for (size_t i = 0; i < n; ++i) {
+        if (sample_scale[i] == 0.0) continue;
+        cell_of_sample[i] = uint32_t(cell_of(points.point(i)));
+        ++start[cell_of_sample[i] + 1];
+    }
+    for (size_t c = 0; c < cell_count; ++c) start[c + 1] += start[c];
+    std::vector<double> values(start[cell_count]);
+    std::vector<uint32_t> filled(start.begin(), start.end() - 1);
+    for (size_t i = 0; i < n; ++i) {
+        if (cell_of_sample[i] == UINT32_MAX) continue;
+        double at = 0.0;
+        for (int k = 0; k < 8; ++k) at += sample_weight[8 * i + size_t(k)] * x[sample_node[8 * i + size_t(k)]];
+        values[filled[cell_of_sample[i]]++] = at;
+    }
+    progress.throw_if_cancelled();
+    const double sigma = noise * points.world_diagonal() * points.normalisation().scale;
+    std::vector<float> correction(cell_count, 0.0f);
+    for (size_t c = 0; c < cell_count; ++c) {
+        const size_t count = start[c + 1] - start[c];
+        if (count < kLevelCellSamples) continue;
+        const auto first = values.begin() + long(start[c]), middle = first + long(count / 2);
+        std::nth_element(first, middle, first + long(count));
+        const double margin = kLevelMedianErrors * kMedianError * sigma / std::sqrt(double(count));
+        const double beyond = std::max(0.0, std::abs(*middle) - margin);
+        correction[c] = float(std::copysign(std::min(beyond, kLevelMaxSteps * h_), *middle));
+    }
+    // Each node takes the trilinear blend of the corrections at the cells' centres.
+    Progress planes_progress = progress.slice(1.0, 1.0);
+    parallel_for(0, size_t(nodes_[2]), workers, planes_progress, [&](size_t plane) {
+        const int64_t z = int64_t(plane);
+        for (int64_t y = 0; y < nodes_[1]; ++y)
+            for (int64_t xi = 0; xi < nodes_[0]; ++xi) {
+                const int32_t u = node(xi, y, z);
+                if (u < 0) continue;
+                const Eigen::Vector3d t = h_ / cell * Eigen::Vector3d(double(xi), double(y), double(z)) -
+                                          Eigen::Vector3d::Constant(0.5);
+                int64_t c[3];
+                double w[3];
+                for (int d = 0; d < 3; ++d) {
+                    c[d] = int64_t(std::floor(t[d]));
+                    w[d] = t[d] - double(c[d]);
+                }
+                double g = 0.0;
+                for (int k = 0; k < 8; ++k) {
+                    const int64_t at[3] = {c[0] + (k & 1), c[1] + (k >> 1 & 1), c[2] + (k >> 2 & 1)};
+                    if (at[0] < 0 || at[1] < 0 || at[2] < 0 || at[0] >= cells[0] || at[1] >= cells[1] ||
+                        at[2] >= cells[2])
+                        continue;
+                    const double weight = (k & 1 ? w[0] : 1 - w[0]) * (k >> 1 & 1 ? w[1] : 1 - w[1]) *
+                                          (k >> 2 & 1 ? w[2] : 1 - w[2]);
+                    g += weight * double(correction[size_t(at[0] + cells[0] * (at[1] + cells[1] * at[2]))]);
+                }
+                x[u] -= g;
+            }
+    }, 1);
+    progress.throw_if_cancelled();
 }
 
 Eigen::Vector3d SmoothField::node_gradient(int64_t x, int64_t y, int64_t z) const {

@@ -11,7 +11,9 @@
 // grid steps of the points, 0 farther) and the
 // screening term pulls the zero set through the points, all weighted alike (Aᵢ: their mean
 // area), with α falling as the estimated noise grows; f is then shifted so that its median
-// over the samples is 0 (its mean, beside thin walls: ZeroLevel). The gradient term
+// over the samples is 0 (its mean, beside thin walls: ZeroLevel), and then, cell by cell
+// of a few grid steps, by what is left of the samples' median there beyond the noise
+// (follow_local_level). The gradient term
 // couples every sample to its neighbours, so a point's noise is averaged over its
 // neighbourhood instead of bending the surface; the normals, which
 // belief propagation made consistent, set the shape. f is about a signed distance,
@@ -58,6 +60,10 @@ struct PointMeasures;
 // the mean keeps them apart (pipeline/smooth_surface.cpp chooses).
 enum class ZeroLevel { median, mean };
 
+// Whether f then follows the samples' level cell by cell (follow_local_level below); off
+// only to observe the global level alone.
+enum class LocalLevel { follow, off };
+
 class SmoothField {
 public:
     SmoothField() = default;
@@ -68,7 +74,8 @@ public:
     // estimate against `max_memory` (LIMIT_EXCEEDED) and polls `progress`, which it reports
     // to 1.
     SmoothField(const PointSet &points, const PointMeasures &measures, double spacing, double min_trust, double noise,
-                ZeroLevel level, double max_memory, Workers &workers, Progress &progress);
+                ZeroLevel level, double max_memory, Workers &workers, Progress &progress,
+                LocalLevel local = LocalLevel::follow);
 
     // f and optionally ∇f at x: the band's where it is defined, else the outer field's;
     // false outside the outer field's box (f is then undefined).
@@ -85,7 +92,7 @@ public:
 
 private:
     static constexpr int B = 8;  // nodes per block side of the sparse storage
-    // An empty field on a grid of step `step` with this one's splat reach and zero level:
+    // An empty field on a grid of step `step` with this one's splat reach and zero levels:
     // the outer field and the cascade's levels.
     SmoothField with_step(double step) const;
     // Returns the shift that made f's median (or mean, level_) over the samples 0. `boundary`
@@ -94,6 +101,16 @@ private:
     double solve(const PointSet &points, const PointMeasures &measures, const std::vector<float> &normals,
                  double min_trust, double noise, double max_memory, const SmoothField *coarse,
                  const SmoothField *boundary, bool whole_box, int iterations, Workers &workers, Progress &progress);
+    // The local zero level: where the samples of a cell of a few grid steps lie on one side
+    // of f's zero set by more than the noise explains (their median past one standard error
+    // of it), f there is shifted by the rest, at most a grid step, blended trilinearly
+    // between the cells' centres. The smoothness term rounds what is sharp or thin at the
+    // grid's scale (a gear's teeth and their roots, a tail's tip) the same way at every
+    // noise; one global level cannot undo that, a stronger pull through every sample follows
+    // the noise everywhere.
+    void follow_local_level(const PointSet &points, const std::vector<int32_t> &sample_node,
+                            const std::vector<double> &sample_weight, const std::vector<double> &sample_scale,
+                            double noise, Eigen::VectorXd &x, Workers &workers, Progress &progress);
     // The grid over the points' box and its blocks within a splat's reach of a point (every
     // block when `whole_box`); checks the memory this level will take against `max_memory`
     // (LIMIT_EXCEEDED). Returns the number of blocks laid out.
@@ -112,6 +129,7 @@ private:
     double min_trust_ = 0.0;
     double max_reach_ = 0.0;          // the longest splat radius, before the cell diagonal
     ZeroLevel level_ = ZeroLevel::median;
+    LocalLevel local_ = LocalLevel::follow;
     int64_t nodes_[3] = {0, 0, 0};     // per axis
     int64_t blocks_[3] = {0, 0, 0};    // per axis
     std::vector<int32_t> block_slot_;  // per block: its slot in node_index_ (÷ B³), or -1
