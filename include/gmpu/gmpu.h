@@ -400,7 +400,9 @@ GMPU_API gmpu_status gmpu_surface_copy_normals_at(const gmpu_surface *surface, c
 
 /* Extracts the zero set of f as a closed, edge-manifold, consistently wound triangle mesh
  * (counter-clockwise seen from outside), restricted to a band around the data so that
- * spurious zero sets of far-away quadrics never become surface. Uses
+ * spurious zero sets of far-away quadrics never become surface. Closed pieces that fit in
+ * a box two grid cubes on a side are dropped beside a larger piece (the grid cannot resolve
+ * them; a finer GMPU_PARAM_RESOLUTION keeps what the data holds at that scale). Uses
  * GMPU_PARAM_RESOLUTION and GMPU_PARAM_LEVEL. The mesh is the caller's: free it with
  * gmpu_mesh_destroy. Never an empty mesh: when no piece of surface is near the points (too
  * few or too sparse for a solid, or a grid too coarse for them) it fails with
