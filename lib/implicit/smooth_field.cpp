@@ -94,6 +94,18 @@ int32_t SmoothField::node(int64_t x, int64_t y, int64_t z) const {
     return node_index_[size_t(slot) * B * B * B + size_t(x % B + B * (y % B + B * (z % B)))];
 }
 
+template <class Visit>
+void SmoothField::for_each_node(Workers &workers, Progress &progress, const Visit &visit) const {
+    parallel_for(0, size_t(nodes_[2]), workers, progress, [&](size_t plane) {
+        const int64_t z = int64_t(plane);
+        for (int64_t y = 0; y < nodes_[1]; ++y)
+            for (int64_t x = 0; x < nodes_[0]; ++x) {
+                const int32_t u = node(x, y, z);
+                if (u >= 0) visit(x, y, z, u);
+            }
+    }, 1);
+}
+
 SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, double spacing, double min_trust,
                          double noise, ZeroLevel level, double max_memory, Workers &workers, Progress &progress,
                          LocalLevel local) {
@@ -308,26 +320,20 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
     Eigen::VectorXd rhs = Eigen::VectorXd::Zero(unknowns), start(unknowns);
     std::vector<Eigen::Vector3d> field(static_cast<size_t>(unknowns));
     Progress planes_progress = progress.slice(0.2, 0.2);  // the loops over planes only check for a cancel
-    parallel_for(0, size_t(nodes_[2]), workers, planes_progress, [&](size_t plane) {
-        const int64_t z = int64_t(plane);
-        for (int64_t y = 0; y < nodes_[1]; ++y)
-            for (int64_t x = 0; x < nodes_[0]; ++x) {
-                const int32_t u = node(x, y, z);
-                if (u < 0) continue;
-                const size_t s = slot_of(x, y, z);
-                // The start: the coarser level's field where it has one, else the smoothed
-                // point-to-plane distance.
-                double c;
-                const Eigen::Vector3d q = origin_ + h_ * Eigen::Vector3d(double(x), double(y), double(z));
-                start[u] = coarse && coarse->value(q, c, nullptr) ? c : wsum[s] > 0.0 ? distance[s] / wsum[s] : 0.0;
-                // The average normal, shortened where neighbours disagree (between two sheets,
-                // across a thin part): there f need not rise at all.
-                field[size_t(u)] =
-                    normal_wsum[s] > 0.0 ? Eigen::Vector3d(-normal[s] / normal_wsum[s]) : Eigen::Vector3d::Zero();
-                const double length = field[size_t(u)].norm();
-                if (length > kAgreeing) field[size_t(u)] /= length;
-            }
-    }, 1);
+    for_each_node(workers, planes_progress, [&](int64_t x, int64_t y, int64_t z, int32_t u) {
+        const size_t s = slot_of(x, y, z);
+        // The start: the coarser level's field where it has one, else the smoothed
+        // point-to-plane distance.
+        double c;
+        const Eigen::Vector3d q = origin_ + h_ * Eigen::Vector3d(double(x), double(y), double(z));
+        start[u] = coarse && coarse->value(q, c, nullptr) ? c : wsum[s] > 0.0 ? distance[s] / wsum[s] : 0.0;
+        // The average normal, shortened where neighbours disagree (between two sheets,
+        // across a thin part): there f need not rise at all.
+        field[size_t(u)] =
+            normal_wsum[s] > 0.0 ? Eigen::Vector3d(-normal[s] / normal_wsum[s]) : Eigen::Vector3d::Zero();
+        const double length = field[size_t(u)].norm();
+        if (length > kAgreeing) field[size_t(u)] /= length;
+    });
     progress.throw_if_cancelled();
     if (whole_box && !coarse) {
         // Away from the points the start copies the nearest band node's (breadth first):
@@ -367,24 +373,18 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
     std::vector<int32_t> neighbours(6 * size_t(unknowns), -1);
     // Each unknown sums its own six edges (in a fixed order: −z, −y, −x, +x, +y, +z), so the
     // planes run in parallel.
-    parallel_for(0, size_t(nodes_[2]), workers, planes_progress, [&](size_t plane) {
-        const int64_t z = int64_t(plane);
-        for (int64_t y = 0; y < nodes_[1]; ++y)
-            for (int64_t x = 0; x < nodes_[0]; ++x) {
-                const int32_t a = node(x, y, z);
-                if (a < 0) continue;
-                for (int side = 0; side < 6; ++side) {
-                    const int d = side < 3 ? 2 - side : side - 3, dir = side < 3 ? -1 : 1;
-                    const int32_t b = node(x + (d == 0) * dir, y + (d == 1) * dir, z + (d == 2) * dir);
-                    if (b < 0) continue;
-                    // f should rise by `rise` from the lower node of the edge to the upper one.
-                    const double rise = h_ * 0.5 * (field[size_t(a)][d] + field[size_t(b)][d]);
-                    edge_diagonal[a] += edge_weight;
-                    neighbours[6 * size_t(a) + 2 * size_t(d) + (dir > 0)] = b;
-                    rhs[a] += dir > 0 ? -edge_weight * rise : edge_weight * rise;
-                }
-            }
-    }, 1);
+    for_each_node(workers, planes_progress, [&](int64_t x, int64_t y, int64_t z, int32_t a) {
+        for (int side = 0; side < 6; ++side) {
+            const int d = side < 3 ? 2 - side : side - 3, dir = side < 3 ? -1 : 1;
+            const int32_t b = node(x + (d == 0) * dir, y + (d == 1) * dir, z + (d == 2) * dir);
+            if (b < 0) continue;
+            // f should rise by `rise` from the lower node of the edge to the upper one.
+            const double rise = h_ * 0.5 * (field[size_t(a)][d] + field[size_t(b)][d]);
+            edge_diagonal[a] += edge_weight;
+            neighbours[6 * size_t(a) + 2 * size_t(d) + (dir > 0)] = b;
+            rhs[a] += dir > 0 ? -edge_weight * rise : edge_weight * rise;
+        }
+    });
     progress.throw_if_cancelled();
     // The band's edge: an edge to a node outside the band asks for the same rise towards the
     // outer field's value there (a Dirichlet condition). Left free, f would keep rising
@@ -595,33 +595,27 @@ void SmoothField::follow_local_level(const PointSet &points, const std::vector<i
     }
     // Each node takes the trilinear blend of the corrections at the cells' centres.
     Progress planes_progress = progress.slice(1.0, 1.0);
-    parallel_for(0, size_t(nodes_[2]), workers, planes_progress, [&](size_t plane) {
-        const int64_t z = int64_t(plane);
-        for (int64_t y = 0; y < nodes_[1]; ++y)
-            for (int64_t xi = 0; xi < nodes_[0]; ++xi) {
-                const int32_t u = node(xi, y, z);
-                if (u < 0) continue;
-                const Eigen::Vector3d t = h_ / cell * Eigen::Vector3d(double(xi), double(y), double(z)) -
-                                          Eigen::Vector3d::Constant(0.5);
-                int64_t c[3];
-                double w[3];
-                for (int d = 0; d < 3; ++d) {
-                    c[d] = int64_t(std::floor(t[d]));
-                    w[d] = t[d] - double(c[d]);
-                }
-                double g = 0.0;
-                for (int k = 0; k < 8; ++k) {
-                    const int64_t at[3] = {c[0] + (k & 1), c[1] + (k >> 1 & 1), c[2] + (k >> 2 & 1)};
-                    if (at[0] < 0 || at[1] < 0 || at[2] < 0 || at[0] >= cells[0] || at[1] >= cells[1] ||
-                        at[2] >= cells[2])
-                        continue;
-                    const double weight = (k & 1 ? w[0] : 1 - w[0]) * (k >> 1 & 1 ? w[1] : 1 - w[1]) *
-                                          (k >> 2 & 1 ? w[2] : 1 - w[2]);
-                    g += weight * double(correction[size_t(at[0] + cells[0] * (at[1] + cells[1] * at[2]))]);
-                }
-                x[u] -= g;
-            }
-    }, 1);
+    for_each_node(workers, planes_progress, [&](int64_t xi, int64_t y, int64_t z, int32_t u) {
+        const Eigen::Vector3d t = h_ / cell * Eigen::Vector3d(double(xi), double(y), double(z)) -
+                                  Eigen::Vector3d::Constant(0.5);
+        int64_t c[3];
+        double w[3];
+        for (int d = 0; d < 3; ++d) {
+            c[d] = int64_t(std::floor(t[d]));
+            w[d] = t[d] - double(c[d]);
+        }
+        double g = 0.0;
+        for (int k = 0; k < 8; ++k) {
+            const int64_t at[3] = {c[0] + (k & 1), c[1] + (k >> 1 & 1), c[2] + (k >> 2 & 1)};
+            if (at[0] < 0 || at[1] < 0 || at[2] < 0 || at[0] >= cells[0] || at[1] >= cells[1] ||
+                at[2] >= cells[2])
+                continue;
+            const double weight = (k & 1 ? w[0] : 1 - w[0]) * (k >> 1 & 1 ? w[1] : 1 - w[1]) *
+                                  (k >> 2 & 1 ? w[2] : 1 - w[2]);
+            g += weight * double(correction[size_t(at[0] + cells[0] * (at[1] + cells[1] * at[2]))]);
+        }
+        x[u] -= g;
+    });
     progress.throw_if_cancelled();
 }
 

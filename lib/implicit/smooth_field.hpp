@@ -122,6 +122,10 @@ private:
     // The band's own value (the fine grid only).
     bool band_value(const Eigen::Vector3d &x, double &f, Eigen::Vector3d *gradient) const;
     int32_t node(int64_t x, int64_t y, int64_t z) const;  // unknown index, -1 outside the band
+    // visit(x, y, z, u) for every node u of the band, the grid's planes in parallel (each
+    // node visited once, so a visit may write its own node's entries).
+    template <class Visit>
+    void for_each_node(Workers &workers, Progress &progress, const Visit &visit) const;
     Eigen::Vector3d node_gradient(int64_t x, int64_t y, int64_t z) const;
 
     Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();
