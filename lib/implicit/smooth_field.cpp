@@ -60,12 +60,21 @@ constexpr double kOuterSteps = 2.0;
 constexpr double kLevelCellSteps = 4.0, kLevelMedianErrors = 1.25, kLevelMaxSteps = 1.0;
 constexpr size_t kLevelCellSamples = 12;
 constexpr double kMedianError = 1.2533;
+// The thin parts' bias (thin_part_bias): f is probed kThinProbe σ inward from each node; a
+// part whose f rises by less than kThinRiseFull of that depth (per |∇f|) is thin and takes
+// the correction in full, one rising by more than kThinRiseNone none, linearly between. On
+// a tube of radius r the rise is r/σ − 1 once the probe passes the axis: full below 1.3 σ,
+// none above 1.6 σ. The correction is kThinBiasShare of σ²/2 Δf (the smoothness term has
+// already rounded the part in part), at most kThinBiasMax σ.
+constexpr double kThinProbe = 2.0, kThinRiseFull = 0.3, kThinRiseNone = 0.6;
+constexpr double kThinBiasShare = 0.5, kThinBiasMax = 0.25;
 // Memory model, for GMPU_PARAM_MAX_MEMORY: per node of a touched block, the splat's sums
 // (weight, distance, the normals' weight and sum) and its index; per unknown, the field,
 // its six neighbours, its row's start and the solver's vectors; per point, its 8 trilinear weights and nodes,
 // its entries in the blocks' and the rows' lists (about 8 blocks, 8 corners) and its value
-// in the products, its cell and value for the local zero level.
-constexpr double kBytesPerSlotNode = 52, kBytesPerUnknown = 200, kBytesPerPoint = 192;
+// in the products, its cell and value for the local zero level; per unknown again, the thin
+// parts' correction.
+constexpr double kBytesPerSlotNode = 52, kBytesPerUnknown = 208, kBytesPerPoint = 192;
 
 // The value the zero set is put at among the samples' values (`values` reordered).
 double sample_level(std::vector<double> &values, ZeroLevel level) {
@@ -108,11 +117,12 @@ void SmoothField::for_each_node(Workers &workers, Progress &progress, const Visi
 
 SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, double spacing, double min_trust,
                          double noise, ZeroLevel level, double max_memory, Workers &workers, Progress &progress,
-                         LocalLevel local) {
+                         LocalLevel local, ThinPartBias thin) {
     if (points.size() == 0) return;
     max_reach_ = kMaxReachSteps * spacing;
     level_ = level;
     local_ = local;
+    thin_ = thin;
     {
         // The fine band takes more memory than the coarser bands: laid out first, its memory
         // check fails a cloud too scattered for the budget before the outer field and the
@@ -157,6 +167,7 @@ SmoothField SmoothField::with_step(double step) const {
     field.max_reach_ = max_reach_;
     field.level_ = level_;
     field.local_ = local_;
+    field.thin_ = thin_;
     return field;
 }
 
@@ -532,6 +543,10 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
         });
         rz_rr = next;
     }
+    const double sigma = noise * points.world_diagonal() * points.normalisation().scale;
+    Eigen::VectorXd thin_bias;
+    if (!whole_box && thin_ == ThinPartBias::correct && sigma > 0.0)
+        thin_bias = thin_part_bias(x, sigma, workers, progress);
     // The zero set through the samples (ZeroLevel): with weak screening the normals'
     // integral alone fixes f up to an offset, which would shrink or swell the whole surface.
     std::vector<double> at_samples;
@@ -545,6 +560,7 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
     const double shift = sample_level(at_samples, level_);
     x.array() -= shift;
     if (!whole_box && local_ == LocalLevel::follow) follow_local_level(points, sample_node, sample_weight, sample_scale, noise, x, workers, progress);
+    if (thin_bias.size() == x.size()) x += thin_bias;
     values_.assign(x.data(), x.data() + unknowns);
     progress.report(1.0);
     return shift;
@@ -617,6 +633,49 @@ void SmoothField::follow_local_level(const PointSet &points, const std::vector<i
         x[u] -= g;
     });
     progress.throw_if_cancelled();
+}
+
+Eigen::VectorXd SmoothField::thin_part_bias(const Eigen::VectorXd &x, double sigma, Workers &workers,
+                                            Progress &progress) const {
+    // x trilinear at grid coordinates t; false where a corner is off the band.
+    auto at = [&](const Eigen::Vector3d &t, double &f) {
+        const int64_t c[3] = {int64_t(std::floor(t[0])), int64_t(std::floor(t[1])), int64_t(std::floor(t[2]))};
+        const double fx = t[0] - double(c[0]), fy = t[1] - double(c[1]), fz = t[2] - double(c[2]);
+        f = 0.0;
+        for (int k = 0; k < 8; ++k) {
+            const int dx = k & 1, dy = k >> 1 & 1, dz = k >> 2 & 1;
+            const int32_t v = node(c[0] + dx, c[1] + dy, c[2] + dz);
+            if (v < 0) return false;
+            f += (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy) * (dz ? fz : 1 - fz) * x[v];
+        }
+        return true;
+    };
+    Eigen::VectorXd bias = Eigen::VectorXd::Zero(x.size());
+    Progress planes_progress = progress.slice(1.0, 1.0);
+    for_each_node(workers, planes_progress, [&](int64_t xi, int64_t y, int64_t z, int32_t u) {
+        double laplacian = -6.0 * x[u];
+        Eigen::Vector3d gradient;
+        for (int d = 0; d < 3; ++d) {
+            const int64_t e[3] = {d == 0, d == 1, d == 2};
+            const int32_t lo = node(xi - e[0], y - e[1], z - e[2]), hi = node(xi + e[0], y + e[1], z + e[2]);
+            if (lo < 0 || hi < 0) return;
+            laplacian += x[lo] + x[hi];
+            gradient[d] = (x[hi] - x[lo]) / (2 * h_);
+        }
+        laplacian /= h_ * h_;
+        const double slope = gradient.norm();
+        if (!(slope > 0.0)) return;
+        // f is positive inside: inward is up its gradient.
+        const double depth = kThinProbe * sigma;
+        double probed;
+        if (!at(Eigen::Vector3d(double(xi), double(y), double(z)) + depth / h_ * gradient / slope, probed)) return;
+        const double rise = (probed - x[u]) / (depth * slope);
+        const double thin = std::clamp((kThinRiseNone - rise) / (kThinRiseNone - kThinRiseFull), 0.0, 1.0);
+        const double limit = kThinBiasMax * sigma * slope;
+        bias[u] = thin * std::clamp(kThinBiasShare * 0.5 * sigma * sigma * laplacian, -limit, limit);
+    });
+    progress.throw_if_cancelled();
+    return bias;
 }
 
 Eigen::Vector3d SmoothField::node_gradient(int64_t x, int64_t y, int64_t z) const {

@@ -13,7 +13,8 @@
 // area), with α falling as the estimated noise grows; f is then shifted so that its median
 // over the samples is 0 (its mean, beside thin walls: ZeroLevel), and then, cell by cell
 // of a few grid steps, by what is left of the samples' median there beyond the noise
-// (follow_local_level). The gradient term
+// (follow_local_level), and on parts thinner than the noise, corrected for the outward bias
+// noise gives a curved surface's samples (thin_part_bias). The gradient term
 // couples every sample to its neighbours, so a point's noise is averaged over its
 // neighbourhood instead of bending the surface; the normals, which
 // belief propagation made consistent, set the shape. f is about a signed distance,
@@ -64,6 +65,10 @@ enum class ZeroLevel { median, mean };
 // only to observe the global level alone.
 enum class LocalLevel { follow, off };
 
+// Whether f is then corrected for the noise's bias on parts thinner than about 1.5 σ
+// (thin_part_bias below); off only to observe the levels alone.
+enum class ThinPartBias { correct, off };
+
 class SmoothField {
 public:
     SmoothField() = default;
@@ -75,7 +80,7 @@ public:
     // to 1.
     SmoothField(const PointSet &points, const PointMeasures &measures, double spacing, double min_trust, double noise,
                 ZeroLevel level, double max_memory, Workers &workers, Progress &progress,
-                LocalLevel local = LocalLevel::follow);
+                LocalLevel local = LocalLevel::follow, ThinPartBias thin = ThinPartBias::correct);
 
     // f and optionally ∇f at x: the band's where it is defined, else the outer field's;
     // false outside the outer field's box (f is then undefined).
@@ -111,6 +116,16 @@ private:
     void follow_local_level(const PointSet &points, const std::vector<int32_t> &sample_node,
                             const std::vector<double> &sample_weight, const std::vector<double> &sample_scale,
                             double noise, Eigen::VectorXd &x, Workers &workers, Progress &progress);
+    // The noise's bias on thin parts, to be added to f (the solution `x`) once its levels
+    // are set. Noise in every direction moves a sample off a curved surface outward on
+    // average: f's expected value at the samples is f + σ²/2 Δf on the surface, so a zero
+    // set through the samples' median lies outward by about σ² times the mean curvature.
+    // On thick parts the smoothness term's own rounding, which moves convex parts inward,
+    // roughly cancels that (a gear's edges lean on it); on parts thinner than about 1.5 σ
+    // (legs, tails, fingers at 1 % noise) the bias stays, and there f takes a share of
+    // σ²/2 Δf, at most a fraction of σ. A part is thin where f, probed inward from a node,
+    // stops rising before it has risen as deep as a thick part's.
+    Eigen::VectorXd thin_part_bias(const Eigen::VectorXd &x, double sigma, Workers &workers, Progress &progress) const;
     // The grid over the points' box and its blocks within a splat's reach of a point (every
     // block when `whole_box`); checks the memory this level will take against `max_memory`
     // (LIMIT_EXCEEDED). Returns the number of blocks laid out.
@@ -134,6 +149,7 @@ private:
     double max_reach_ = 0.0;          // the longest splat radius, before the cell diagonal
     ZeroLevel level_ = ZeroLevel::median;
     LocalLevel local_ = LocalLevel::follow;
+    ThinPartBias thin_ = ThinPartBias::correct;
     int64_t nodes_[3] = {0, 0, 0};     // per axis
     int64_t blocks_[3] = {0, 0, 0};    // per axis
     std::vector<int32_t> block_slot_;  // per block: its slot in node_index_ (÷ B³), or -1
