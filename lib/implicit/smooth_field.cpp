@@ -77,6 +77,14 @@ constexpr double kThinBiasShare = 0.5, kThinBiasMax = 0.25;
 constexpr double kBytesPerSlotNode = 52, kBytesPerUnknown = 208, kBytesPerPoint = 192;
 
 // The value the zero set is put at among the samples' values (`values` reordered).
+// f (the solution `x`) at sample i: its cube's corners blended trilinearly.
+double sample_value(const std::vector<int32_t> &sample_node, const std::vector<double> &sample_weight, size_t i,
+                    const Eigen::VectorXd &x) {
+    double at = 0.0;
+    for (size_t k = 0; k < 8; ++k) at += sample_weight[8 * i + k] * x[sample_node[8 * i + k]];
+    return at;
+}
+
 double sample_level(std::vector<double> &values, ZeroLevel level) {
     if (values.empty()) return 0.0;
     if (level == ZeroLevel::mean) {
@@ -101,6 +109,20 @@ int32_t SmoothField::node(int64_t x, int64_t y, int64_t z) const {
     const int32_t slot = block_slot_[size_t(x / B + blocks_[0] * (y / B + blocks_[1] * (z / B)))];
     if (slot < 0) return -1;
     return node_index_[size_t(slot) * B * B * B + size_t(x % B + B * (y % B + B * (z % B)))];
+}
+
+SmoothField::Corners SmoothField::corners(const Eigen::Vector3d &t) const {
+    Corners k;
+    for (int d = 0; d < 3; ++d) k.base[d] = int64_t(std::floor(t[d]));
+    const double fx = t[0] - double(k.base[0]), fy = t[1] - double(k.base[1]), fz = t[2] - double(k.base[2]);
+    k.complete = true;
+    for (int i = 0; i < 8; ++i) {
+        const int dx = i & 1, dy = i >> 1 & 1, dz = i >> 2 & 1;
+        k.node[i] = node(k.base[0] + dx, k.base[1] + dy, k.base[2] + dz);
+        k.complete &= k.node[i] >= 0;
+        k.weight[i] = (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy) * (dz ? fz : 1 - fz);
+    }
+    return k;
 }
 
 template <class Visit>
@@ -436,20 +458,13 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
     std::vector<double> sample_weight(8 * n, 0.0), sample_scale(n, 0.0);
     for (size_t i = 0; i < n; ++i) {
         if (i % 4096 == 0) progress.poll(0.3 + 0.1 * double(i) / double(n));
-        const Eigen::Vector3d t = (points.point(i) - origin_) / h_;
-        const int64_t c[3] = {int64_t(std::floor(t[0])), int64_t(std::floor(t[1])), int64_t(std::floor(t[2]))};
-        const double fx = t[0] - double(c[0]), fy = t[1] - double(c[1]), fz = t[2] - double(c[2]);
-        bool complete = true;
-        for (int k = 0; k < 8; ++k) {
-            const int dx = k & 1, dy = k >> 1 & 1, dz = k >> 2 & 1;
-            sample_node[8 * i + size_t(k)] = node(c[0] + dx, c[1] + dy, c[2] + dz);
-            complete &= sample_node[8 * i + size_t(k)] >= 0;
-            sample_weight[8 * i + size_t(k)] = (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy) * (dz ? fz : 1 - fz);
-        }
+        const Corners corner = corners((points.point(i) - origin_) / h_);
+        std::copy(corner.node, corner.node + 8, sample_node.begin() + long(8 * i));
+        std::copy(corner.weight, corner.weight + 8, sample_weight.begin() + long(8 * i));
         // Always complete (the band covers a cell diagonal around every point); a sample
         // that were not would simply not pull.
-        sample_scale[i] = complete ? alpha * mean_area : 0.0;
-        if (!complete) continue;
+        sample_scale[i] = corner.complete ? alpha * mean_area : 0.0;
+        if (!corner.complete) continue;
         for (int k = 0; k < 8; ++k)
             diagonal[sample_node[8 * i + size_t(k)]] +=
                 sample_scale[i] * sample_weight[8 * i + size_t(k)] * sample_weight[8 * i + size_t(k)];
@@ -552,14 +567,12 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
     std::vector<double> at_samples;
     at_samples.reserve(n);
     for (size_t i = 0; i < n; ++i) {
-        if (sample_scale[i] == 0.0) continue;
-        double at = 0.0;
-        for (int k = 0; k < 8; ++k) at += sample_weight[8 * i + size_t(k)] * x[sample_node[8 * i + size_t(k)]];
-        at_samples.push_back(at);
+        if (sample_scale[i] != 0.0) at_samples.push_back(sample_value(sample_node, sample_weight, i, x));
     }
     const double shift = sample_level(at_samples, level_);
     x.array() -= shift;
-    if (!whole_box && local_ == LocalLevel::follow) follow_local_level(points, sample_node, sample_weight, sample_scale, noise, x, workers, progress);
+    if (!whole_box && local_ == LocalLevel::follow)
+        follow_local_level(points, sample_node, sample_weight, sample_scale, sigma, x, workers, progress);
     if (thin_bias.size() == x.size()) x += thin_bias;
     values_.assign(x.data(), x.data() + unknowns);
     progress.report(1.0);
@@ -568,7 +581,7 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
 
 void SmoothField::follow_local_level(const PointSet &points, const std::vector<int32_t> &sample_node,
                                      const std::vector<double> &sample_weight, const std::vector<double> &sample_scale,
-                                     double noise, Eigen::VectorXd &x, Workers &workers, Progress &progress) {
+                                     double sigma, Eigen::VectorXd &x, Workers &workers, Progress &progress) {
     const double cell = kLevelCellSteps * h_;
     int64_t cells[3];
     for (int d = 0; d < 3; ++d) cells[d] = int64_t(std::ceil(double(nodes_[d]) * h_ / cell)) + 1;
@@ -592,13 +605,10 @@ void SmoothField::follow_local_level(const PointSet &points, const std::vector<i
     std::vector<double> values(start[cell_count]);
     std::vector<uint32_t> filled(start.begin(), start.end() - 1);
     for (size_t i = 0; i < n; ++i) {
-        if (cell_of_sample[i] == UINT32_MAX) continue;
-        double at = 0.0;
-        for (int k = 0; k < 8; ++k) at += sample_weight[8 * i + size_t(k)] * x[sample_node[8 * i + size_t(k)]];
-        values[filled[cell_of_sample[i]]++] = at;
+        if (cell_of_sample[i] != UINT32_MAX)
+            values[filled[cell_of_sample[i]]++] = sample_value(sample_node, sample_weight, i, x);
     }
     progress.throw_if_cancelled();
-    const double sigma = noise * points.world_diagonal() * points.normalisation().scale;
     std::vector<float> correction(cell_count, 0.0f);
     for (size_t c = 0; c < cell_count; ++c) {
         const size_t count = start[c + 1] - start[c];
@@ -639,15 +649,10 @@ Eigen::VectorXd SmoothField::thin_part_bias(const Eigen::VectorXd &x, double sig
                                             Progress &progress) const {
     // x trilinear at grid coordinates t; false where a corner is off the band.
     auto at = [&](const Eigen::Vector3d &t, double &f) {
-        const int64_t c[3] = {int64_t(std::floor(t[0])), int64_t(std::floor(t[1])), int64_t(std::floor(t[2]))};
-        const double fx = t[0] - double(c[0]), fy = t[1] - double(c[1]), fz = t[2] - double(c[2]);
+        const Corners corner = corners(t);
+        if (!corner.complete) return false;
         f = 0.0;
-        for (int k = 0; k < 8; ++k) {
-            const int dx = k & 1, dy = k >> 1 & 1, dz = k >> 2 & 1;
-            const int32_t v = node(c[0] + dx, c[1] + dy, c[2] + dz);
-            if (v < 0) return false;
-            f += (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy) * (dz ? fz : 1 - fz) * x[v];
-        }
+        for (int k = 0; k < 8; ++k) f += corner.weight[k] * x[corner.node[k]];
         return true;
     };
     Eigen::VectorXd bias = Eigen::VectorXd::Zero(x.size());
@@ -701,17 +706,15 @@ bool SmoothField::band_value(const Eigen::Vector3d &x, double &f, Eigen::Vector3
     if (values_.empty()) return false;
     const Eigen::Vector3d t = (x - origin_) / h_;
     if (!(t.array() >= 0.0).all() || !(t.array() < 1e9).all()) return false;
-    const int64_t c[3] = {int64_t(std::floor(t[0])), int64_t(std::floor(t[1])), int64_t(std::floor(t[2]))};
-    const double fx = t[0] - double(c[0]), fy = t[1] - double(c[1]), fz = t[2] - double(c[2]);
+    const Corners corner = corners(t);
+    if (!corner.complete) return false;
     f = 0.0;
     if (gradient) gradient->setZero();
     for (int k = 0; k < 8; ++k) {
-        const int dx = k & 1, dy = k >> 1 & 1, dz = k >> 2 & 1;
-        const int32_t u = node(c[0] + dx, c[1] + dy, c[2] + dz);
-        if (u < 0) return false;
-        const double w = (dx ? fx : 1 - fx) * (dy ? fy : 1 - fy) * (dz ? fz : 1 - fz);
-        f += w * values_[size_t(u)];
-        if (gradient) *gradient += w * node_gradient(c[0] + dx, c[1] + dy, c[2] + dz);
+        f += corner.weight[k] * values_[size_t(corner.node[k])];
+        if (gradient)
+            *gradient += corner.weight[k] * node_gradient(corner.base[0] + (k & 1), corner.base[1] + (k >> 1 & 1),
+                                                          corner.base[2] + (k >> 2 & 1));
     }
     return true;
 }

@@ -112,10 +112,10 @@ private:
     // between the cells' centres. The smoothness term rounds what is sharp or thin at the
     // grid's scale (a gear's teeth and their roots, a tail's tip) the same way at every
     // noise; one global level cannot undo that, a stronger pull through every sample follows
-    // the noise everywhere.
+    // the noise everywhere. `sigma`: the noise's deviation on this grid (normalised units).
     void follow_local_level(const PointSet &points, const std::vector<int32_t> &sample_node,
                             const std::vector<double> &sample_weight, const std::vector<double> &sample_scale,
-                            double noise, Eigen::VectorXd &x, Workers &workers, Progress &progress);
+                            double sigma, Eigen::VectorXd &x, Workers &workers, Progress &progress);
     // The noise's bias on thin parts, to be added to f (the solution `x`) once its levels
     // are set. Noise in every direction moves a sample off a curved surface outward on
     // average: f's expected value at the samples is f + σ²/2 Δf on the surface, so a zero
@@ -137,6 +137,16 @@ private:
     // The band's own value (the fine grid only).
     bool band_value(const Eigen::Vector3d &x, double &f, Eigen::Vector3d *gradient) const;
     int32_t node(int64_t x, int64_t y, int64_t z) const;  // unknown index, -1 outside the band
+    // The grid cube holding grid coordinates t: its lowest corner, its 8 corners' unknowns
+    // (corner k at base + (k & 1, k >> 1 & 1, k >> 2 & 1); −1 off the band) and trilinear
+    // weights, and whether all 8 lie on the band.
+    struct Corners {
+        int64_t base[3];
+        int32_t node[8];
+        double weight[8];
+        bool complete;
+    };
+    Corners corners(const Eigen::Vector3d &t) const;
     // visit(x, y, z, u) for every node u of the band, the grid's planes in parallel (each
     // node visited once, so a visit may write its own node's entries).
     template <class Visit>
