@@ -76,7 +76,6 @@ constexpr double kThinBiasShare = 0.5, kThinBiasMax = 0.25;
 // parts' correction.
 constexpr double kBytesPerSlotNode = 52, kBytesPerUnknown = 208, kBytesPerPoint = 192;
 
-// The value the zero set is put at among the samples' values (`values` reordered).
 // f (the solution `x`) at sample i: its cube's corners blended trilinearly.
 double sample_value(const std::vector<int32_t> &sample_node, const std::vector<double> &sample_weight, size_t i,
                     const Eigen::VectorXd &x) {
@@ -85,6 +84,7 @@ double sample_value(const std::vector<int32_t> &sample_node, const std::vector<d
     return at;
 }
 
+// The value the zero set is put at among the samples' values (`values` reordered).
 double sample_level(std::vector<double> &values, ZeroLevel level) {
     if (values.empty()) return 0.0;
     if (level == ZeroLevel::mean) {
