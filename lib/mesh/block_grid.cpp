@@ -11,6 +11,12 @@ namespace {
 // a hair, so with one a point at the box's edge can mark block 0, and the band would reach
 // the grid's edge, leaving open a surface that crosses it.
 double grid_pad(double widest, double h) { return widest + 2 * BlockGrid::B * h; }
+// The winding number beyond which a block of the outside region lies within the solid: the
+// enclosed regions' test. Those blocks lie beyond every trust radius, where telling about 0
+// from about 1 needs less accuracy than an enclosed region's single query: cells count as
+// one dipole from kReachFarRatio radii on.
+constexpr double kInsideWinding = 0.5;
+constexpr double kReachFarRatio = 1.2;
 }  // namespace
 
 double BlockGrid::blocks_for(const PointSet &points, int resolution, double widest) {
@@ -100,6 +106,51 @@ void BlockGrid::sign_far_regions(const WindingField &winding, Progress &progress
     far_sign.assign(size_t(nb), 0);
     for (int64_t b = 0; b < nb; ++b)
         if (!band[size_t(b)]) far_sign[size_t(b)] = region_sign[size_t(region[size_t(b)])];
+    sign_inside_reaches(winding, region, progress);
+}
+
+void BlockGrid::sign_inside_reaches(const WindingField &winding, const std::vector<int32_t> &region,
+                                    Progress &progress) {
+    const int64_t nb = int64_t(band.size());
+    const int64_t step[3] = {1, blocks[0], blocks[0] * blocks[1]};
+    auto each_face_neighbour = [&](int64_t b, auto &&visit) {
+        int64_t pos[3];
+        block_position(b, pos);
+        for (int d = 0; d < 3; ++d)
+            for (int side = -1; side <= 1; side += 2)
+                if (pos[d] + side >= 0 && pos[d] + side < blocks[d]) visit(b + side * step[d]);
+    };
+    // A block's answer stays the same when band_sign_seams makes the regions anew.
+    reach_winding.resize(size_t(nb), kNotAsked);
+    auto inside = [&](int64_t b) {
+        if (reach_winding[size_t(b)] == kNotAsked) {
+            progress.tick();
+            reach_winding[size_t(b)] = winding.winding(block_box(b).center(), kReachFarRatio) > kInsideWinding;
+        }
+        return reach_winding[size_t(b)] == 1;
+    };
+    // Seeds: the outside region's blocks along the band.
+    std::vector<int64_t> stack;
+    for (int64_t b = 0; b < nb; ++b) {
+        if (b % 4096 == 0) progress.tick();
+        if (!band[size_t(b)]) continue;
+        each_face_neighbour(b, [&](int64_t next) {
+            if (region[size_t(next)] == 0 && far_sign[size_t(next)] < 0 && inside(next)) {
+                far_sign[size_t(next)] = 1;
+                stack.push_back(next);
+            }
+        });
+    }
+    while (!stack.empty()) {
+        const int64_t b = stack.back();
+        stack.pop_back();
+        each_face_neighbour(b, [&](int64_t next) {
+            if (region[size_t(next)] == 0 && far_sign[size_t(next)] < 0 && inside(next)) {
+                far_sign[size_t(next)] = 1;
+                stack.push_back(next);
+            }
+        });
+    }
 }
 
 bool BlockGrid::band_sign_seams() {

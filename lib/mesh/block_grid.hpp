@@ -63,6 +63,14 @@ struct BlockGrid {
 private:
     void mark_band(const PointSet &points, const std::vector<float> &trust_radius, double min_trust, Progress &progress);
     void sign_far_regions(const WindingField &winding, Progress &progress);
+    // The outside region can reach into the solid through an opening the band leaves (the
+    // bore of an open-ended tube whose two faces the noise merged into one sheet, a scan's
+    // hole): its blocks reached from the band across blocks whose winding number says
+    // inside take the inside sign, so the surface closes across the opening (the seams
+    // between them join the band) instead of around the band's edge inside the solid.
+    void sign_inside_reaches(const WindingField &winding, const std::vector<int32_t> &region, Progress &progress);
+    static constexpr uint8_t kNotAsked = 2;
+    std::vector<uint8_t> reach_winding;  // per block: 1 inside, 0 outside, kNotAsked
     // Adds to the band every inside far block that meets an outside one across an edge or a
     // corner only (the regions are face-connected, so two of opposite signs can touch so):
     // the corners they share take the outside's sign, so the surface passes through the
