@@ -12,11 +12,14 @@ namespace {
 // the grid's edge, leaving open a surface that crosses it.
 double grid_pad(double widest, double h) { return widest + 2 * BlockGrid::B * h; }
 // The winding number beyond which a block of the outside region lies within the solid: the
-// enclosed regions' test. Those blocks lie beyond every trust radius, where telling about 0
-// from about 1 needs less accuracy than an enclosed region's single query: cells count as
-// one dipole from kReachFarRatio radii on.
+// enclosed regions' test, at its accuracy (across an opening the winding number falls
+// through ½ gradually, and a coarser sum left the shark scan's holes as they were). Most
+// blocks along the band are plainly outside, and a coarse sum (cells as one dipole from
+// kCoarseFarRatio radii on, cheap where the noise-limited fit left large leaves) tells them
+// when it reads under kPlainlyOutside.
 constexpr double kInsideWinding = 0.5;
-constexpr double kReachFarRatio = 1.2;
+constexpr double kCoarseFarRatio = 1.2;
+constexpr double kPlainlyOutside = 0.25;
 }  // namespace
 
 double BlockGrid::blocks_for(const PointSet &points, int resolution, double widest) {
@@ -125,7 +128,9 @@ void BlockGrid::sign_inside_reaches(const WindingField &winding, const std::vect
     auto inside = [&](int64_t b) {
         if (reach_winding[size_t(b)] == kNotAsked) {
             progress.tick();
-            reach_winding[size_t(b)] = winding.winding(block_box(b).center(), kReachFarRatio) > kInsideWinding;
+            const Eigen::Vector3d centre = block_box(b).center();
+            reach_winding[size_t(b)] = winding.winding(centre, kCoarseFarRatio) >= kPlainlyOutside &&
+                                       winding.winding(centre) > kInsideWinding;
         }
         return reach_winding[size_t(b)] == 1;
     };
