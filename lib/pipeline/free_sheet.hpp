@@ -32,4 +32,13 @@ bool is_free_sheet(const WindingField &winding, const PointSet &points, const st
 void split_sheet_faces(const MpuFunction &mpu, const PointSet &points, PointMeasures &measures, Workers &workers,
                        Progress &progress);
 
+// The same where only a part of the cloud is a free sheet: a thin part (a blade, a fin, a
+// spine) whose faces the noise merged, standing off a solid. The test is read at a sample of
+// the points, `offset` behind and in front of each, and every point goes with the majority
+// of the samples among its nearest neighbours; the points of free parts on the inside of
+// `mpu` have their normals turned. Returns how many were turned (the winding field must then
+// be made again).
+size_t split_local_sheet_faces(const WindingField &winding, const MpuFunction &mpu, const PointSet &points,
+                               PointMeasures &measures, double offset, Workers &workers, Progress &progress);
+
 }  // namespace gmpu

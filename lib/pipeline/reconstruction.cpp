@@ -128,12 +128,18 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
     if (strays) mesh = Mesh();
     const SurfaceKind kind = surface_kind(params, points, noise, thin_walls, strays);
     const bool wants_smooth = needs_smooth_field(kind);
-    // Noise-limited fits of a thin wall may make one free sheet of it (free_sheet.hpp); the
-    // smooth field, not the blend, can make a slab of that.
-    if (wants_smooth && noisy_fits &&
-        is_free_sheet(winding, points, measures.blend_normals, kFreeSheetOffset * noise, winding_progress)) {
-        split_sheet_faces(mpu, points, measures, pool, winding_progress);
-        winding = WindingField(tree, points, measures.blend_normals, measures.area, &winding_progress);
+    // Noise-limited fits of a thin wall may make one free sheet of it, or of a thin part of
+    // a solid (free_sheet.hpp); the smooth field, not the blend, can make a slab of that.
+    if (wants_smooth && noisy_fits) {
+        const double offset = kFreeSheetOffset * noise;
+        size_t turned = 0;
+        if (is_free_sheet(winding, points, measures.blend_normals, offset, winding_progress)) {
+            split_sheet_faces(mpu, points, measures, pool, winding_progress);
+            turned = points.size();
+        } else {
+            turned = split_local_sheet_faces(winding, mpu, points, measures, offset, pool, winding_progress);
+        }
+        if (turned > 0) winding = WindingField(tree, points, measures.blend_normals, measures.area, &winding_progress);
     }
     std::shared_ptr<const SmoothField> new_smooth =
         wants_smooth
