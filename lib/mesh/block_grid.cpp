@@ -43,8 +43,9 @@ BlockGrid::BlockGrid(const PointSet &points, int resolution, const std::vector<f
         cubes[d] = blocks[d] * B;
     }
     mark_band(points, trust_radius, min_trust, progress);
-    sign_far_regions(winding, progress);
-    while (band_sign_seams()) sign_far_regions(winding, progress);
+    InsideAnswers answers(band.size(), kNotAsked);
+    sign_far_regions(winding, answers, progress);
+    while (band_sign_seams()) sign_far_regions(winding, answers, progress);
 }
 
 Eigen::AlignedBox3d BlockGrid::block_box(int64_t id) const {
@@ -75,12 +76,11 @@ void BlockGrid::mark_band(const PointSet &points, const std::vector<float> &trus
     }
 }
 
-void BlockGrid::sign_far_regions(const WindingField &winding, Progress &progress) {
+void BlockGrid::sign_far_regions(const WindingField &winding, InsideAnswers &answers, Progress &progress) {
     const int64_t nb = int64_t(band.size());
     std::vector<int32_t> region(size_t(nb), -1);
     std::vector<int8_t> region_sign;
     std::vector<int64_t> stack;
-    const int64_t step[3] = {1, blocks[0], blocks[0] * blocks[1]};
     for (int64_t s = 0; s < nb; ++s) {
         if (s % 4096 == 0) progress.tick();  // one winding query per region, O(blocks) in all
         if (band[size_t(s)] || region[size_t(s)] >= 0) continue;
@@ -94,67 +94,49 @@ void BlockGrid::sign_far_regions(const WindingField &winding, Progress &progress
             if (filled % 16384 == 0) progress.tick();  // the outside region spans most blocks
             const int64_t b = stack.back();
             stack.pop_back();
-            int64_t pos[3];
-            block_position(b, pos);
-            for (int d = 0; d < 3; ++d)
-                for (int side = -1; side <= 1; side += 2) {
-                    if (pos[d] + side < 0 || pos[d] + side >= blocks[d]) continue;
-                    const int64_t next = b + side * step[d];
-                    if (band[size_t(next)] || region[size_t(next)] >= 0) continue;
-                    region[size_t(next)] = id;
-                    stack.push_back(next);
-                }
+            each_face_neighbour(b, [&](int64_t next) {
+                if (band[size_t(next)] || region[size_t(next)] >= 0) return;
+                region[size_t(next)] = id;
+                stack.push_back(next);
+            });
         }
     }
     far_sign.assign(size_t(nb), 0);
     for (int64_t b = 0; b < nb; ++b)
         if (!band[size_t(b)]) far_sign[size_t(b)] = region_sign[size_t(region[size_t(b)])];
-    sign_inside_reaches(winding, region, progress);
+    sign_inside_reaches(winding, region, answers, progress);
 }
 
 void BlockGrid::sign_inside_reaches(const WindingField &winding, const std::vector<int32_t> &region,
-                                    Progress &progress) {
-    const int64_t nb = int64_t(band.size());
-    const int64_t step[3] = {1, blocks[0], blocks[0] * blocks[1]};
-    auto each_face_neighbour = [&](int64_t b, auto &&visit) {
-        int64_t pos[3];
-        block_position(b, pos);
-        for (int d = 0; d < 3; ++d)
-            for (int side = -1; side <= 1; side += 2)
-                if (pos[d] + side >= 0 && pos[d] + side < blocks[d]) visit(b + side * step[d]);
-    };
-    // A block's answer stays the same when band_sign_seams makes the regions anew.
-    reach_winding.resize(size_t(nb), kNotAsked);
+                                    InsideAnswers &answers, Progress &progress) {
     auto inside = [&](int64_t b) {
-        if (reach_winding[size_t(b)] == kNotAsked) {
+        if (answers[size_t(b)] == kNotAsked) {
             progress.tick();
             const Eigen::Vector3d centre = block_box(b).center();
-            reach_winding[size_t(b)] = winding.winding(centre, kCoarseFarRatio) >= kPlainlyOutside &&
-                                       winding.winding(centre) > kInsideWinding;
+            answers[size_t(b)] = winding.winding(centre, kCoarseFarRatio) >= kPlainlyOutside &&
+                                 winding.winding(centre) > kInsideWinding;
         }
-        return reach_winding[size_t(b)] == 1;
+        return answers[size_t(b)] == 1;
     };
-    // Seeds: the outside region's blocks along the band.
+    // An outside block next to block b, if inside, takes the inside sign and is filled from.
     std::vector<int64_t> stack;
-    for (int64_t b = 0; b < nb; ++b) {
-        if (b % 4096 == 0) progress.tick();
-        if (!band[size_t(b)]) continue;
+    auto claim_neighbours = [&](int64_t b) {
         each_face_neighbour(b, [&](int64_t next) {
             if (region[size_t(next)] == 0 && far_sign[size_t(next)] < 0 && inside(next)) {
                 far_sign[size_t(next)] = 1;
                 stack.push_back(next);
             }
         });
+    };
+    // Seeds: the outside region's blocks along the band.
+    for (int64_t b = 0; b < int64_t(band.size()); ++b) {
+        if (b % 4096 == 0) progress.tick();
+        if (band[size_t(b)]) claim_neighbours(b);
     }
     while (!stack.empty()) {
         const int64_t b = stack.back();
         stack.pop_back();
-        each_face_neighbour(b, [&](int64_t next) {
-            if (region[size_t(next)] == 0 && far_sign[size_t(next)] < 0 && inside(next)) {
-                far_sign[size_t(next)] = 1;
-                stack.push_back(next);
-            }
-        });
+        claim_neighbours(b);
     }
 }
 

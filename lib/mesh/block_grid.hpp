@@ -62,15 +62,28 @@ struct BlockGrid {
 
 private:
     void mark_band(const PointSet &points, const std::vector<float> &trust_radius, double min_trust, Progress &progress);
-    void sign_far_regions(const WindingField &winding, Progress &progress);
+    // Per block, what sign_inside_reaches asked the winding number: kNotAsked, or whether
+    // the block lies inside. A block's answer stays the same as the regions are made anew.
+    static constexpr uint8_t kNotAsked = 2;
+    using InsideAnswers = std::vector<uint8_t>;
+    void sign_far_regions(const WindingField &winding, InsideAnswers &answers, Progress &progress);
     // The outside region can reach into the solid through an opening the band leaves (the
     // bore of an open-ended tube whose two faces the noise merged into one sheet, a scan's
     // hole): its blocks reached from the band across blocks whose winding number says
     // inside take the inside sign, so the surface closes across the opening (the seams
     // between them join the band) instead of around the band's edge inside the solid.
-    void sign_inside_reaches(const WindingField &winding, const std::vector<int32_t> &region, Progress &progress);
-    static constexpr uint8_t kNotAsked = 2;
-    std::vector<uint8_t> reach_winding;  // per block: 1 inside, 0 outside, kNotAsked
+    void sign_inside_reaches(const WindingField &winding, const std::vector<int32_t> &region, InsideAnswers &answers,
+                             Progress &progress);
+    // Calls visit(next) for each block sharing a face with block b.
+    template <class Visit>
+    void each_face_neighbour(int64_t b, Visit &&visit) const {
+        const int64_t step[3] = {1, blocks[0], blocks[0] * blocks[1]};
+        int64_t pos[3];
+        block_position(b, pos);
+        for (int d = 0; d < 3; ++d)
+            for (int side = -1; side <= 1; side += 2)
+                if (pos[d] + side >= 0 && pos[d] + side < blocks[d]) visit(b + side * step[d]);
+    }
     // Adds to the band every inside far block that meets an outside one across an edge or a
     // corner only (the regions are face-connected, so two of opposite signs can touch so):
     // the corners they share take the outside's sign, so the surface passes through the

@@ -33,12 +33,18 @@ constexpr int kLocalMinFree = 2;
 // this many of its spacings.
 constexpr double kMinOffsetPerSpacing = 1.0;
 
-bool reads_free(const WindingField &winding, const Eigen::Vector3d &p, const Eigen::Vector3d &n, double offset,
-                double ratio) {
-    const double behind = winding.winding(p - offset * n), in_front = winding.winding(p + offset * n);
-    const double centre = 0.5 * (behind + in_front), jump = behind - in_front;
-    return jump > kMinJump && std::fabs(centre) < ratio * jump;
-}
+// The winding number `offset` behind and in front of point p (outward normal n): its centre
+// and its jump, and whether they are a free sheet's at the given centre-to-jump ratio.
+struct SheetReading {
+    double centre = 0.0, jump = 0.0;
+    SheetReading(const WindingField &winding, const Eigen::Vector3d &p, const Eigen::Vector3d &n, double offset) {
+        const double behind = winding.winding(p - offset * n), in_front = winding.winding(p + offset * n);
+        centre = 0.5 * (behind + in_front);
+        jump = behind - in_front;
+    }
+    SheetReading(double centre_, double jump_) : centre(centre_), jump(jump_) {}
+    bool free(double ratio) const { return jump > kMinJump && std::fabs(centre) < ratio * jump; }
+};
 
 void turn_normal(PointMeasures &measures, size_t i) {
     for (size_t d = 0; d < 3; ++d) {
@@ -65,13 +71,11 @@ bool is_free_sheet(const WindingField &winding, const PointSet &points, const st
     std::vector<double> centre, jump;
     for (size_t i = 0; i < points.size(); i += stride) {
         progress.tick();
-        const Eigen::Vector3d p = points.point(i), n = normal_of(normals, uint32_t(i));
-        const double behind = winding.winding(p - offset * n), in_front = winding.winding(p + offset * n);
-        centre.push_back(0.5 * (behind + in_front));
-        jump.push_back(behind - in_front);
+        const SheetReading reading(winding, points.point(i), normal_of(normals, uint32_t(i)), offset);
+        centre.push_back(reading.centre);
+        jump.push_back(reading.jump);
     }
-    const double c = median(centre), j = median(jump);
-    return j > kMinJump && std::fabs(c) < kFreeRatio * j;
+    return SheetReading(median(centre), median(jump)).free(kFreeRatio);
 }
 
 void split_sheet_faces(const MpuFunction &mpu, const PointSet &points, PointMeasures &measures, Workers &workers,
@@ -91,8 +95,8 @@ size_t split_local_sheet_faces(const WindingField &winding, const MpuFunction &m
     parallel_for(0, (n + kLocalStride - 1) / kLocalStride, workers, progress, [&](size_t s) {
         const size_t i = s * kLocalStride;
         if (offset < kMinOffsetPerSpacing * std::sqrt(double(measures.area[i]))) return;
-        sample[i] = reads_free(winding, points.point(i), normal_of(measures.blend_normals, uint32_t(i)), offset,
-                               kLocalFreeRatio);
+        sample[i] = SheetReading(winding, points.point(i), normal_of(measures.blend_normals, uint32_t(i)), offset)
+                        .free(kLocalFreeRatio);
     });
     // Only points near a sample that reads free can have a majority of such samples among
     // their neighbours (most clouds have none or a few): those within twice the voters of one.
