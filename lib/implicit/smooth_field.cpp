@@ -48,6 +48,17 @@ constexpr double kMaxReachSteps = 12.0;
 // other and, over a misoriented patch, makes f rise along the wrong normals over the
 // whole band instead of a few cells.
 constexpr double kNormalReachSteps = 3.0;
+// V fades where a node lies off the side of the points that reach it rather than over them:
+// from kOverhangFull to kOverhangNone of the normals' reach between the node and the
+// points' weighted centre, measured across their mean normal. Past a thin part's edge (a
+// plate's rim, a blade's tip) the faces' normals reach the node from one side only, and a
+// full-length V there asks f to rise towards the part's middle plane beyond the edge: the
+// part grows a fin as long as the reach. Over a sheet, between two sheets or across a thin
+// part the points lie on all sides of the node and V is unchanged. Only where the normals
+// disagree (their weighted mean shorter than kOverhangAgreement: a thin part's two faces
+// and its rim): near a single face's edge or bend (a CAD part's edges) the points' centre
+// moves to the side as well, and a V faded there rounds the part.
+constexpr double kOverhangFull = 0.15, kOverhangNone = 0.35, kOverhangAgreement = 0.9;
 // The outer field's grid step, in fine steps: coarse enough to cover the whole box at a
 // small cost, fine enough to keep a thin wall's two sides apart where it hands over.
 constexpr double kOuterSteps = 2.0;
@@ -69,12 +80,12 @@ constexpr double kMedianError = 1.2533;
 constexpr double kThinProbe = 2.0, kThinRiseFull = 0.3, kThinRiseNone = 0.6;
 constexpr double kThinBiasShare = 0.5, kThinBiasMax = 0.25;
 // Memory model, for GMPU_PARAM_MAX_MEMORY: per node of a touched block, the splat's sums
-// (weight, distance, the normals' weight and sum) and its index; per unknown, the field,
+// (weight, distance, the normals' weight, sum and offset) and its index; per unknown, the field,
 // its six neighbours, its row's start and the solver's vectors; per point, its 8 trilinear weights and nodes,
 // its entries in the blocks' and the rows' lists (about 8 blocks, 8 corners) and its value
 // in the products, its cell and value for the local zero level; per unknown again, the thin
 // parts' correction.
-constexpr double kBytesPerSlotNode = 52, kBytesPerUnknown = 208, kBytesPerPoint = 192;
+constexpr double kBytesPerSlotNode = 76, kBytesPerUnknown = 208, kBytesPerPoint = 192;
 
 // f (the solution `x`) at sample i: its cube's corners blended trilinearly.
 double sample_value(const std::vector<int32_t> &sample_node, const std::vector<double> &sample_weight, size_t i,
@@ -100,6 +111,18 @@ double sample_level(std::vector<double> &values, ZeroLevel level) {
 double weight(double d2, double r2) {
     const double t = 1.0 - d2 / r2;
     return t > 0.0 ? t * t : 0.0;
+}
+
+// V's factor at a node whose points' weighted centre lies at `offset` from it and whose
+// normals' weighted mean is `mean` (kOverhangFull above). Where the normals cancel (`mean`
+// very short: both faces of a thin part alike) the whole offset counts.
+double overhang_fade(const Eigen::Vector3d &offset, const Eigen::Vector3d &mean, double reach) {
+    constexpr double kDirectionless = 0.05;
+    const double length = mean.norm();
+    if (length >= kOverhangAgreement) return 1.0;
+    const Eigen::Vector3d across =
+        length > kDirectionless ? Eigen::Vector3d(offset - offset.dot(mean / length) * (mean / length)) : offset;
+    return std::clamp((kOverhangNone - across.norm() / reach) / (kOverhangNone - kOverhangFull), 0.0, 1.0);
 }
 
 }  // namespace
@@ -274,11 +297,12 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
     auto radius = [&](size_t i) { return splat_radius(measures, i, min_trust); };
     auto node_box = [&](size_t i, int64_t lo[3], int64_t hi[3]) { box_of(points.point(i), radius(i), lo, hi); };
 
-    // Splat: per node the weighted sums of the normals and of the point-to-plane distances.
+    // Splat: per node the weighted sums of the normals, of the offsets to the points and of
+    // the point-to-plane distances.
     constexpr size_t BBB = size_t(B) * B * B;
     const size_t slot_nodes = size_t(slots) * BBB;
     std::vector<double> wsum(slot_nodes, 0.0), distance(slot_nodes, 0.0), normal_wsum(slot_nodes, 0.0);
-    std::vector<Eigen::Vector3d> normal(slot_nodes, Eigen::Vector3d::Zero());
+    std::vector<Eigen::Vector3d> normal(slot_nodes, Eigen::Vector3d::Zero()), offset(slot_nodes, Eigen::Vector3d::Zero());
     auto slot_of = [&](int64_t x, int64_t y, int64_t z) {
         return size_t(block_slot_[size_t(x / B + blocks_[0] * (y / B + blocks_[1] * (z / B)))]) * BBB +
                size_t(x % B + B * (y % B + B * (z % B)));
@@ -322,8 +346,8 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
             const Eigen::Vector3d p = points.point(i);
             const Eigen::Vector3d nrm(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);
             const double r = radius(i), r2 = r * r;
-            const double normal_reach = std::min(r, (kNormalReachSteps + std::sqrt(3.0)) * h_);
-            const double normal_r2 = normal_reach * normal_reach;
+            const double normal_r = std::min(r, (kNormalReachSteps + std::sqrt(3.0)) * h_);
+            const double normal_r2 = normal_r * normal_r;
             for (int64_t z = lo[2]; z <= hi[2]; ++z)
                 for (int64_t y = lo[1]; y <= hi[1]; ++y)
                     for (int64_t x = lo[0]; x <= hi[0]; ++x) {
@@ -335,6 +359,7 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
                         const double wn = weight(d2, normal_r2);
                         normal_wsum[s] += wn;
                         normal[s] += wn * nrm;
+                        offset[s] += wn * (p - q);
                         distance[s] += w * (p - q).dot(nrm);  // inside (behind the normal): positive
                     }
         }
@@ -352,6 +377,7 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
     // its 27-neighbour stencil assembled.
     Eigen::VectorXd rhs = Eigen::VectorXd::Zero(unknowns), start(unknowns);
     std::vector<Eigen::Vector3d> field(static_cast<size_t>(unknowns));
+    const double normal_reach = (kNormalReachSteps + std::sqrt(3.0)) * h_;
     Progress planes_progress = progress.slice(0.2, 0.2);  // the loops over planes only check for a cancel
     for_each_node(workers, planes_progress, [&](int64_t x, int64_t y, int64_t z, int32_t u) {
         const size_t s = slot_of(x, y, z);
@@ -366,6 +392,8 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
             normal_wsum[s] > 0.0 ? Eigen::Vector3d(-normal[s] / normal_wsum[s]) : Eigen::Vector3d::Zero();
         const double length = field[size_t(u)].norm();
         if (length > kAgreeing) field[size_t(u)] /= length;
+        if (normal_wsum[s] > 0.0)
+            field[size_t(u)] *= overhang_fade(offset[s] / normal_wsum[s], normal[s] / normal_wsum[s], normal_reach);
     });
     progress.throw_if_cancelled();
     if (whole_box && !coarse) {

@@ -8,7 +8,8 @@
 // Hoppe 2013): on a regular grid restricted to a band around the points, f minimises
 //     ∫ |∇f − V|²  +  α Σᵢ Aᵢ f(pᵢ)²
 // where V is the splatted field of the inward normals (unit where they agree; within a few
-// grid steps of the points, 0 farther) and the
+// grid steps of the points, 0 farther, fading where the points lie to one side of a node
+// rather than under it: past a thin part's edge) and the
 // screening term pulls the zero set through the points, all weighted alike (Aᵢ: their mean
 // area), with α falling as the estimated noise grows; f is then shifted so that its median
 // over the samples is 0 (its mean, beside thin walls: ZeroLevel), and then, cell by cell
