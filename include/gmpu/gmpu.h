@@ -176,9 +176,10 @@ typedef enum gmpu_param {
      * sample spacing of that smooth implicit: the blend's detail where the two agree, the
      * smooth implicit's shape where the blend strays (past the end of a thin part, bridges
      * between parts that nearly touch). 2: 1 where fit's estimated noise is at least 0.3 % of
-     * the bounding-box diagonal, else 3 on clouds of fewer than 20,000 points in which fit
-     * found no thin walls (two sheets in one leaf), and on clouds of up to 200,000 such points
-     * where the blend's mesh strays from the data (over 0.5 % of its area more than 5 local
+     * the bounding-box diagonal, else 3 on clouds of fewer than 20,000 points (where fit
+     * found thin walls, two sheets in one leaf, held less tightly where the smooth implicit
+     * has merged a wall's two sheets), and on clouds of up to 200,000 points without thin
+     * walls where the blend's mesh strays from the data (over 0.5 % of its area more than 5 local
      * sample spacings from every point: a lump past a sparse foot, a bridge), there with the
      * smooth implicit on a grid twice as coarse and held to within one spacing; else 0. Read
      * by orient (which makes that test's mesh, handed out by the next polygonize if the blend

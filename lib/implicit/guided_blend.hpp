@@ -14,13 +14,37 @@
 // f is continuous, and its zero set is the blend's wherever the blend stays within the
 // limit of the smooth surface. Away from the data the far field signs f as for the blend
 // (surface_field.hpp): the smooth field's outer part is only there to bound its band.
+//
+// Where two sheets of a thin wall lie closer than the smooth field's grid can keep apart,
+// their opposite normals cancel in the field it integrates: there it is flat, neither inside
+// nor outside, while the blend keeps both sheets. A limit in f's units would pull the
+// blend's inside of the wall to the smooth value and cut holes through it. So the limit can
+// be measured in distance instead: divided by |∇s| (a signed distance has |∇s| ≈ 1), no
+// less steep than `min_slope`, it widens where the smooth field is flat and lets the wall
+// stand. On a sparse cloud without thin walls the field is flatter than that near every
+// sparsely sampled tip, where its guide is wanted, so there the limit stays fixed.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 
 #include <Eigen/Core>
 
 namespace gmpu {
+
+// How far the blend may depart from the smooth field: `limit` (normalised units; infinite:
+// not guided), widened by 1/|∇s| where the smooth field's slope is under 1, down to
+// `min_slope` (1: never widened).
+struct Guide {
+    double limit = INFINITY;
+    double min_slope = 1.0;
+
+    bool active() const { return std::isfinite(limit); }
+    bool widens() const { return min_slope < 1.0; }
+    double limit_at(const Eigen::Vector3d &smooth_gradient) const {
+        return limit / std::clamp(smooth_gradient.norm(), min_slope, 1.0);
+    }
+};
 
 // f from the blend's value b and the smooth field's s; with gradients (both given or both
 // null), ∇f: the blend's where it is kept, the smooth field's where it is held.

@@ -334,6 +334,8 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
     std::vector<int64_t> slot_block(static_cast<size_t>(slots));
     for (size_t b = 0; b < block_slot_.size(); ++b)
         if (block_slot_[b] >= 0) slot_block[size_t(block_slot_[b])] = int64_t(b);
+    // V's reach from a point (capped by the point's own radius in the splat).
+    const double normal_reach = (kNormalReachSteps + std::sqrt(3.0)) * h_;
     Progress splat_progress = progress.slice(0.05, 0.2);
     parallel_for(0, size_t(slots), workers, splat_progress, [&](size_t slot) {
         const int64_t b = slot_block[slot];
@@ -346,7 +348,7 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
             const Eigen::Vector3d p = points.point(i);
             const Eigen::Vector3d nrm(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);
             const double r = radius(i), r2 = r * r;
-            const double normal_r = std::min(r, (kNormalReachSteps + std::sqrt(3.0)) * h_);
+            const double normal_r = std::min(r, normal_reach);
             const double normal_r2 = normal_r * normal_r;
             for (int64_t z = lo[2]; z <= hi[2]; ++z)
                 for (int64_t y = lo[1]; y <= hi[1]; ++y)
@@ -377,7 +379,6 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
     // its 27-neighbour stencil assembled.
     Eigen::VectorXd rhs = Eigen::VectorXd::Zero(unknowns), start(unknowns);
     std::vector<Eigen::Vector3d> field(static_cast<size_t>(unknowns));
-    const double normal_reach = (kNormalReachSteps + std::sqrt(3.0)) * h_;
     Progress planes_progress = progress.slice(0.2, 0.2);  // the loops over planes only check for a cancel
     for_each_node(workers, planes_progress, [&](int64_t x, int64_t y, int64_t z, int32_t u) {
         const size_t s = slot_of(x, y, z);

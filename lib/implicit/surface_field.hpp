@@ -62,11 +62,11 @@ public:
     // (see far_value); an empty one leaves it to the side test. All are kept by reference
     // except the blend, a small view.
     // `smooth` (may be null or empty) replaces the blend where it is defined, or with a
-    // finite `guide_limit` (normalised units) guides it (guided_blend.hpp).
+    // finite limit in `guide` guides it (guided_blend.hpp).
     SurfaceField(const MpuFunction &mpu, const PointSet &points, const PointMeasures &measures,
-                 const WindingField &winding, const SmoothField *smooth = nullptr, double guide_limit = INFINITY)
+                 const WindingField &winding, const SmoothField *smooth = nullptr, const Guide &guide = Guide())
         : mpu_(mpu), points_(points), measures_(measures), winding_(winding),
-          smooth_(smooth && !smooth->empty() ? smooth : nullptr), guide_limit_(guide_limit) {}
+          smooth_(smooth && !smooth->empty() ? smooth : nullptr), guide_(guide) {}
 
     // The same field for a polygonizer's grid: `min_trust` widens every trust radius to at
     // least that (two cube sizes, so every cube the surface crosses has its corners
@@ -110,7 +110,7 @@ public:
     double widest_trust() const { return std::max(measures_.widest_trust, min_trust_); }
 
     // Whether the smooth field guides the blend rather than replacing it.
-    bool guided() const { return smooth_ && std::isfinite(guide_limit_); }
+    bool guided() const { return smooth_ && guide_.active(); }
     // Whether untrusted queries take the smooth field's (outer) value, not the far field.
     bool smooth_beyond_trust() const { return smooth_ && !guided(); }
 
@@ -128,11 +128,11 @@ private:
         if (!guided()) return smooth_->value(x, s, gradient) ? s : blend(gradient);
         Eigen::Vector3d gs, gb;
         const double b = blend(gradient ? &gb : nullptr);
-        if (!smooth_->value(x, s, gradient ? &gs : nullptr)) {
+        if (!smooth_->value(x, s, gradient || guide_.widens() ? &gs : nullptr)) {
             if (gradient) *gradient = gb;
             return b;
         }
-        return guided_value(b, s, guide_limit_, &gb, &gs, gradient);
+        return guided_value(b, s, guide_.widens() ? guide_.limit_at(gs) : guide_.limit, &gb, &gs, gradient);
     }
 
     MpuFunction mpu_;
@@ -140,7 +140,7 @@ private:
     const PointMeasures &measures_;
     const WindingField &winding_;
     const SmoothField *smooth_ = nullptr;
-    double guide_limit_ = INFINITY;
+    Guide guide_;
     double min_trust_ = 0.0, search_bound_ = INFINITY;
 };
 

@@ -61,7 +61,7 @@ void Reconstruction::discard_fit() {
     measures = PointMeasures();
     winding = WindingField();
     smooth.reset();
-    guide = INFINITY;
+    guide = Guide();
     smooth_kind = SurfaceKind::blend;
     strays_tested = strays_found = false;
     tested_mesh = Mesh();
@@ -101,7 +101,7 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
     // can use as it is.
     winding = WindingField();
     smooth.reset();
-    guide = INFINITY;
+    guide = Guide();
     Orientation orientation = orient_octree(tree, points, input_normals.empty() ? nullptr : input_normals.data(),
                                             pool, signs_progress);
     const MpuFunction mpu(tree, orientation.signs, 0);
@@ -155,7 +155,7 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
     finish(progress);
     smooth = std::move(new_smooth);
     smooth_kind = kind;
-    guide = kind == SurfaceKind::guided_blend ? guide_limit(points, measures) : INFINITY;
+    guide = kind == SurfaceKind::guided_blend ? guide_for(points, measures, thin_walls) : Guide();
     strays_tested = test_strays;
     strays_found = strays;
     tested_mesh = std::move(mesh);
@@ -195,7 +195,7 @@ Mesh Reconstruction::polygonize(const Params &params, int resolution, Progress &
         strays_tested = true;
         strays_found = blend_strays(stray_share(mesh));
         if (!strays_found) {
-            smooth.reset(), smooth_kind = SurfaceKind::blend, guide = INFINITY;
+            smooth.reset(), smooth_kind = SurfaceKind::blend, guide = Guide();
             return mesh;
         }
     }
@@ -204,7 +204,7 @@ Mesh Reconstruction::polygonize(const Params &params, int resolution, Progress &
     else if (!smooth || smooth_coarsening(kind, points) != smooth_coarsening(smooth_kind, points))
         smooth = solve_smooth_surface(params, kind, tree, points, measures, noise, thin_walls, pool, solve_progress);
     smooth_kind = kind;
-    guide = kind == SurfaceKind::guided_blend ? guide_limit(points, measures) : INFINITY;
+    guide = kind == SurfaceKind::guided_blend ? guide_for(points, measures, thin_walls) : Guide();
     return gmpu::polygonize(field(params.level), resolution, params, pool, march_progress, noise);
 }
 

@@ -39,9 +39,9 @@ struct Reconstruction {
     // The smooth field (pipeline/smooth_surface.hpp) when GMPU_PARAM_SURFACE asked for it
     // at the last orient or polygonize; null: the MPU blend.
     std::shared_ptr<const SmoothField> smooth;
-    // With the smooth field: the limit to which it holds the blend (implicit/guided_blend.hpp),
-    // or ∞ where it replaces the blend.
-    double guide = INFINITY;
+    // With the smooth field: how far it lets the blend depart (implicit/guided_blend.hpp), or
+    // no guide where it replaces the blend.
+    Guide guide;
     // The surface the smooth field was solved for (its grid depends on it: smooth_surface.hpp):
     // with `smooth`, the surface evaluate and polygonize use (without it, the blend).
     SurfaceKind smooth_kind = SurfaceKind::blend;

@@ -26,9 +26,8 @@ constexpr double kResolveFromNoise = 0.0075;
 // quarter as large, and the parts the correction takes for thin there are more often a CAD
 // part's fins and webs, whose rounding the bias offsets, than tubes made too thick.
 constexpr double kThinBiasFromNoise = 0.0075;
-// GMPU_PARAM_SURFACE = 2 guides the blend on noise-free clouds of fewer points than this
-// (unless the fit found thin walls): there leaves hold few points and the blend strays past
-// thin parts' ends. On denser clouds the blend alone is mostly as close, and the smooth
+// GMPU_PARAM_SURFACE = 2 guides the blend on noise-free clouds of fewer points than this:
+// there leaves hold few points and the blend strays past thin parts' ends. On denser clouds the blend alone is mostly as close, and the smooth
 // solve would cost several times the rest of the run: it is guided only where it strays
 // (blend_strays.hpp).
 constexpr size_t kGuideBelowPoints = 20000;
@@ -40,6 +39,12 @@ constexpr double kGuideSpacings = 0.25;
 // several spacings out, and the coarser field is a fraction of a spacing off the finer one.
 constexpr int kDenseGuideCoarsening = 2;
 constexpr double kDenseGuideSpacings = 1.0;
+// Where the fit found thin walls, the guide's limit widens where the smooth field is flatter
+// than a signed distance, at most by 1 / this (Guide, guided_blend.hpp): there the field has
+// merged a wall's two sheets, which the blend keeps. A higher floor (less widening) lets
+// the guide punch holes through walls the field has only half merged; a lower one leaves
+// more of the blend's strays past a thin part's end.
+constexpr double kThinWallGuideMinSlope = 0.5;
 
 // Clouds of more points are not tested for strays: the guiding solve's grid follows the
 // point spacing, and from a few hundred thousand points on it would take several times the
@@ -81,7 +86,7 @@ SurfaceKind surface_kind(const Params &params, const PointSet &points, double no
     case 3: return SurfaceKind::guided_blend;
     default:
         if (noise_fraction(points, noise) >= kSmoothFromNoise) return SurfaceKind::smooth;
-        return !thin_walls && (!dense(points) || blend_strays) ? SurfaceKind::guided_blend : SurfaceKind::blend;
+        return !dense(points) || (!thin_walls && blend_strays) ? SurfaceKind::guided_blend : SurfaceKind::blend;
     }
 }
 
@@ -90,8 +95,11 @@ bool strays_decide(const Params &params, const PointSet &points, double noise, b
            surface_kind(params, points, noise, thin_walls, true);
 }
 
-double guide_limit(const PointSet &points, const PointMeasures &measures) {
-    return (dense(points) ? kDenseGuideSpacings : kGuideSpacings) * median_spacing(measures);
+Guide guide_for(const PointSet &points, const PointMeasures &measures, bool thin_walls) {
+    Guide guide;
+    guide.limit = (dense(points) ? kDenseGuideSpacings : kGuideSpacings) * median_spacing(measures);
+    if (thin_walls) guide.min_slope = kThinWallGuideMinSlope;
+    return guide;
 }
 
 bool normals_follow_smooth_field(SurfaceKind kind, const PointSet &points) {

@@ -1,9 +1,9 @@
 // Which implicit a reconstruction hands out (GMPU_PARAM_SURFACE): the MPU blend (0), the
 // smooth field solved from the oriented points (1), the blend guided by the smooth field
 // (3, implicit/guided_blend.hpp), or automatically (2, the default): the smooth field where
-// the estimated noise says the blend would follow it, the guided blend on small clouds
-// without thin walls and on larger ones (up to a few hundred thousand points) where the
-// blend strays from the data (pipeline/blend_strays.hpp), else the blend.
+// the estimated noise says the blend would follow it, the guided blend on small clouds and
+// on larger ones without thin walls (up to a few hundred thousand points) where the blend
+// strays from the data (pipeline/blend_strays.hpp), else the blend.
 #pragma once
 
 #include <memory>
@@ -11,6 +11,7 @@
 #include "core/params.hpp"
 #include "core/progress.hpp"
 #include "geometry/point_set.hpp"
+#include "implicit/guided_blend.hpp"
 #include "implicit/point_measures.hpp"
 #include "implicit/smooth_field.hpp"
 #include "model/octree.hpp"
@@ -20,8 +21,8 @@ namespace gmpu {
 enum class SurfaceKind { blend, smooth, guided_blend };
 
 // What `params` asks for, given the fit's estimated noise (normalised units), the points,
-// whether the fit found thin walls (two sheets closer than the smooth field's grid can
-// keep apart on a sparse cloud: the automatic choice leaves them to the blend), and whether
+// whether the fit found thin walls (two sheets in one support: on a dense cloud the
+// automatic choice leaves them to the blend, whose strays are not tested), and whether
 // the blend strays from the data (pipeline/blend_strays.hpp; false when not tested).
 SurfaceKind surface_kind(const Params &params, const PointSet &points, double noise, bool thin_walls,
                          bool blend_strays);
@@ -35,8 +36,9 @@ inline bool needs_smooth_field(SurfaceKind kind) { return kind != SurfaceKind::b
 
 // How far the guided blend may depart from the smooth field (normalised units): a fraction
 // of the points' median spacing on small clouds, a spacing on dense ones (whose smooth
-// field is solved on a coarser grid, solve_smooth_surface).
-double guide_limit(const PointSet &points, const PointMeasures &measures);
+// field is solved on a coarser grid, solve_smooth_surface); where the fit found
+// `thin_walls`, widened where the smooth field is flat (Guide).
+Guide guide_for(const PointSet &points, const PointMeasures &measures, bool thin_walls);
 
 // The grid (cubes along the longest side) the smooth field is solved on, and polygonize's
 // default when it is used: the octree's default, refined to the points' spacing.
