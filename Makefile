@@ -27,7 +27,7 @@ define apt_install
 endef
 
 .PHONY: all deps deps-test deps-bench build demo test test-c test-python test-node test-rust test-consumers \
-        test-sanitize bench bench-quick bench-corpus bench-heldout fuzz clean plugins deps-plugins test-plugins \
+        test-sanitize bench bench-quick bench-corpus bench-heldout bench-thinwall fuzz clean plugins deps-plugins test-plugins \
         plugin-screenshots
 
 all: build
@@ -210,6 +210,14 @@ bench: deps-bench build
 	$(PYTHON) tests/bench/update_readme.py bench-results
 	$(MAKE) --no-print-directory bench-meshes
 	$(MAKE) --no-print-directory bench-dask
+	$(MAKE) --no-print-directory bench-thinwall
+
+# Sparse thin-walled shapes the corpus does not have (tests/data/thinwall, generated into
+# bench-results/thinwall/clouds): gmpu alone against the true meshes, a Markdown table on
+# stdout (~1 min). BASELINE=path/to/other/gmpu-reconstruct adds an older build's columns.
+.PHONY: bench-thinwall
+bench-thinwall: deps-bench build
+	$(PYTHON) tests/bench/thinwall.py --build $(BUILD) $(if $(BASELINE),--baseline $(BASELINE))
 
 # Decimation, level-of-detail topology, trimmed open scans, mesh size and polygonize share,
 # the bunny at 35k and 1M points, sharp-edge normal error (tests/bench/mesh_ops.py;
