@@ -106,6 +106,15 @@ void measure_areas(const Octree &tree, const PointSet &points, Workers &workers,
 
 }  // namespace
 
+void restore_full_trust(PointMeasures &measures) {
+    measures.widest_trust = 0.0;
+    for (size_t i = 0; i < measures.area.size(); ++i) {
+        const double rk = std::sqrt(double(kNeighbours) * double(measures.area[i]) / M_PI);
+        measures.trust_radius[i] = float(kTrustSpacings * rk);
+        measures.widest_trust = std::max(measures.widest_trust, double(measures.trust_radius[i]));
+    }
+}
+
 std::vector<float> point_normals(const MpuFunction &mpu, const PointSet &points, Workers &workers,
                                  Progress &progress, bool from_sheets, std::vector<float> *blend_normals) {
     const Octree &tree = mpu.tree();

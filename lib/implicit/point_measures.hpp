@@ -30,6 +30,11 @@ struct PointMeasures {
 PointMeasures measure_points(const MpuFunction &mpu, const PointSet &points, Workers &workers, Progress &progress,
                              bool noisy_fits = false);
 
+// Every point's trust at its full reach, from its area: undoes the shrinking of sparse
+// clouds' trust (which keeps the blend from extrapolating) for a surface that does not
+// extrapolate, so the trusted shell around the points has no holes.
+void restore_full_trust(PointMeasures &measures);
+
 // Unit outward normal at every input point: −∇f/|∇f|, or the oriented fit of the point's
 // leaf where ∇f vanishes; with from_sheets, from the leaves whose sheet passes by the point
 // where there are any (on_sheet_normal.hpp). 3 floats per point. `blend_normals`, if given,

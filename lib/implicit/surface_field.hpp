@@ -30,6 +30,7 @@
 #include "implicit/guided_blend.hpp"
 #include "implicit/mpu_function.hpp"
 #include "implicit/point_measures.hpp"
+#include "implicit/shell_field.hpp"
 #include "implicit/smooth_field.hpp"
 #include "implicit/winding_field.hpp"
 
@@ -62,11 +63,15 @@ public:
     // (see far_value); an empty one leaves it to the side test. All are kept by reference
     // except the blend, a small view.
     // `smooth` (may be null or empty) replaces the blend where it is defined, or with a
-    // finite limit in `guide` guides it (guided_blend.hpp).
+    // finite limit in `guide` guides it (guided_blend.hpp). `shell` (may be null or empty)
+    // replaces both: trusted queries take the thin shell's wall (shell_field.hpp), or the far
+    // value where no patch of it reaches.
     SurfaceField(const MpuFunction &mpu, const PointSet &points, const PointMeasures &measures,
-                 const WindingField &winding, const SmoothField *smooth = nullptr, const Guide &guide = Guide())
+                 const WindingField &winding, const SmoothField *smooth = nullptr, const Guide &guide = Guide(),
+                 const ShellField *shell = nullptr)
         : mpu_(mpu), points_(points), measures_(measures), winding_(winding),
-          smooth_(smooth && !smooth->empty() ? smooth : nullptr), guide_(guide) {}
+          smooth_(smooth && !smooth->empty() ? smooth : nullptr), guide_(guide),
+          shell_(shell && !shell->empty() ? shell : nullptr) {}
 
     // The same field for a polygonizer's grid: `min_trust` widens every trust radius to at
     // least that (two cube sizes, so every cube the surface crosses has its corners
@@ -124,6 +129,7 @@ private:
     template <class Blend>
     double compose(const Blend &blend, const Eigen::Vector3d &x, Eigen::Vector3d *gradient) const {
         double s;
+        if (shell_) return shell_->value(points_, x, s, gradient) ? s : far_value(x, gradient);
         if (!smooth_) return blend(gradient);
         if (!guided()) return smooth_->value(x, s, gradient) ? s : blend(gradient);
         Eigen::Vector3d gs, gb;
@@ -141,6 +147,7 @@ private:
     const WindingField &winding_;
     const SmoothField *smooth_ = nullptr;
     Guide guide_;
+    const ShellField *shell_ = nullptr;
     double min_trust_ = 0.0, search_bound_ = INFINITY;
 };
 

@@ -66,8 +66,9 @@ void Reconstruction::discard_fit() {
     strays_tested = strays_found = false;
     tested_mesh = Mesh();
     orient_stats = {};
-    blend_grid = smooth_grid = 0;
+    blend_grid = smooth_grid = shell_grid = 0;
     thin_walls = false;
+    shell.reset();
 }
 
 void Reconstruction::fit(const Params &params, Progress &progress) {
@@ -76,10 +77,13 @@ void Reconstruction::fit(const Params &params, Progress &progress) {
     const NoiseEstimate estimate = estimate_noise_model(points, progress);
     const double new_noise = estimate.sigma;
     const double new_epsilon = effective_epsilon(points, params, new_noise);
-    Octree new_tree = build_octree(points, params, new_epsilon, pool, progress, estimate.close_sheets);
+    Progress tree_progress = progress.slice(0.0, 0.95), shell_progress = progress.slice(0.95, 1.0);
+    Octree new_tree = build_octree(points, params, new_epsilon, pool, tree_progress, estimate.close_sheets);
+    std::shared_ptr<const ShellField> new_shell = thin_shell_reading(points, new_noise, pool, shell_progress);
     finish(progress);
     discard_fit();
     tree = std::move(new_tree);
+    shell = std::move(new_shell);
     noise = new_noise;
     epsilon = new_epsilon;
     thin_walls = std::isfinite(thin_wall_gap(tree));
@@ -89,8 +93,10 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
     Workers &pool = workers(params.threads);
     progress.report(0.0, true);
     // Whether the automatic surface depends on the blend's strays: the blend is then tested.
-    const bool test_strays = strays_decide(params, points, noise, thin_walls);
-    const bool may_smooth = test_strays || needs_smooth_field(surface_kind(params, points, noise, thin_walls, false));
+    const bool thin_shell = shell != nullptr;
+    const bool test_strays = strays_decide(params, points, noise, thin_walls, thin_shell);
+    const bool may_smooth =
+        test_strays || needs_smooth_field(surface_kind(params, points, noise, thin_walls, thin_shell, false));
     // The steps' shares of the stage's progress.
     const double signs_end = test_strays ? 0.4 : may_smooth ? 0.8 : 0.9, winding_end = signs_end + (may_smooth ? 0.05 : 0.1),
                  strays_end = test_strays ? 0.85 : winding_end;
@@ -126,7 +132,17 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
     }
     const bool strays = test_strays && blend_strays(stray_share(mesh));
     if (strays) mesh = Mesh();
-    const SurfaceKind kind = surface_kind(params, points, noise, thin_walls, strays);
+    const SurfaceKind kind = surface_kind(params, points, noise, thin_walls, thin_shell, strays);
+    // A thin shell's points face away from its wall's middle, each to its own side: no
+    // orientation of the merged sheet gives them that.
+    if (kind == SurfaceKind::shell) {
+        parallel_for(0, points.size(), pool, winding_progress, [&](size_t i) {
+            const Eigen::Vector3d n = shell->outward_normal(points, i);
+            for (int d = 0; d < 3; ++d) measures.normals[3 * i + d] = measures.blend_normals[3 * i + d] = float(n[d]);
+        });
+        restore_full_trust(measures);
+        winding = WindingField(tree, points, measures.blend_normals, measures.area, &winding_progress);
+    }
     const bool wants_smooth = needs_smooth_field(kind);
     // Noise-limited fits of a thin wall may make one free sheet of it, or of a thin part of
     // a solid (free_sheet.hpp); the smooth field, not the blend, can make a slab of that.
@@ -152,6 +168,7 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
     }
     blend_grid = blend_resolution();
     smooth_grid = smooth_resolution(tree, measures);
+    shell_grid = shell ? shell_resolution(*shell, blend_grid) : 0;
     finish(progress);
     smooth = std::move(new_smooth);
     smooth_kind = kind;
@@ -185,7 +202,13 @@ Mesh Reconstruction::polygonize(const Params &params, int resolution, Progress &
     if (field_matches(params)) return gmpu::polygonize(field(params.level), resolution, params, pool, progress, noise);
     // The surface parameter changed since orient: test the blend, solve or drop the smooth
     // field first.
-    const bool test_strays = !strays_tested && strays_decide(params, points, noise, thin_walls);
+    // To or from the thin shell's wall the point normals change: orient again.
+    if ((surface_for(params) == SurfaceKind::shell) != (smooth_kind == SurfaceKind::shell)) {
+        Progress orient_progress = progress.slice(0.0, 0.3), rest = progress.slice(0.3, 1.0);
+        orient(params, orient_progress);
+        return polygonize(params, resolution, rest, made_at_orient);
+    }
+    const bool test_strays = !strays_tested && strays_decide(params, points, noise, thin_walls, shell != nullptr);
     const double strays_end = test_strays ? 0.7 : 0.0, solve_end = test_strays ? 0.8 : 0.3;
     Progress strays_progress = progress.slice(0.0, strays_end), solve_progress = progress.slice(strays_end, solve_end),
              march_progress = progress.slice(solve_end, 1.0);
@@ -210,7 +233,9 @@ Mesh Reconstruction::polygonize(const Params &params, int resolution, Progress &
 
 int Reconstruction::default_resolution(const Params &params) const {
     // The guided blend's detail is the blend's: its grid too.
-    const bool smooth_grid_wanted = surface_for(params) == SurfaceKind::smooth;
+    const SurfaceKind kind = surface_for(params);
+    const bool smooth_grid_wanted = kind == SurfaceKind::smooth;
+    if (kind == SurfaceKind::shell) return shell_grid > 0 ? shell_grid : shell_resolution(*shell, blend_resolution());
     if (blend_grid > 0) return smooth_grid_wanted ? smooth_grid : blend_grid;
     return smooth_grid_wanted ? smooth_resolution(tree, measures) : blend_resolution();
 }
@@ -221,8 +246,8 @@ int Reconstruction::blend_resolution() const {
 }
 
 bool Reconstruction::field_matches(const Params &params) const {
-    if (!strays_tested && strays_decide(params, points, noise, thin_walls)) return false;
-    return surface_for(params) == (smooth ? smooth_kind : SurfaceKind::blend);
+    if (!strays_tested && strays_decide(params, points, noise, thin_walls, shell != nullptr)) return false;
+    return surface_for(params) == (smooth || smooth_kind == SurfaceKind::shell ? smooth_kind : SurfaceKind::blend);
 }
 
 void Reconstruction::evaluate(const Params &params, const double *xyz, size_t count, double *values,

@@ -43,7 +43,8 @@ struct Reconstruction {
     // no guide where it replaces the blend.
     Guide guide;
     // The surface the smooth field was solved for (its grid depends on it: smooth_surface.hpp):
-    // with `smooth`, the surface evaluate and polygonize use (without it, the blend).
+    // with `smooth`, the surface evaluate and polygonize use (without it, the blend, or the
+    // thin shell's wall when this is shell).
     SurfaceKind smooth_kind = SurfaceKind::blend;
     // Whether the blend was tested for strays (pipeline/blend_strays.hpp; only where the
     // automatic surface depends on it, at orient or polygonize) and found them.
@@ -61,9 +62,12 @@ struct Reconstruction {
     OrientStats orient_stats;
     // The default grids of the last orient, blend's and smooth field's: evaluate asks for one
     // on every call, and each is a pass over every cell and point.
-    int blend_grid = 0, smooth_grid = 0;
+    int blend_grid = 0, smooth_grid = 0, shell_grid = 0;
     double noise = 0.0, epsilon = 0.0;     // of the last fit, normalised units
     bool thin_walls = false;               // whether the last fit found any (polygonizer.hpp: thin_wall_gap)
+    // The last fit's reading of the cloud as one thin shell (smooth_surface.hpp:
+    // thin_shell_reading); null where it is not one. The surface when smooth_kind is shell.
+    std::shared_ptr<const ShellField> shell;
 
     // Fit: noise estimate, ε, adaptive octree of local fits.
     void fit(const Params &params, Progress &progress);
@@ -93,7 +97,8 @@ struct Reconstruction {
     // leaves): the one field evaluate and polygonize both ask. A view: valid while this
     // reconstruction is not changed.
     SurfaceField field(int level) const {
-        return SurfaceField(MpuFunction(tree, signs, level), points, measures, winding, smooth.get(), guide);
+        return SurfaceField(MpuFunction(tree, signs, level), points, measures, winding, smooth.get(), guide,
+                            smooth_kind == SurfaceKind::shell ? shell.get() : nullptr);
     }
 
     // Forget fit and orient (the points stay).
@@ -102,7 +107,7 @@ struct Reconstruction {
     // The surface `params` asks for (smooth_surface.hpp: surface_kind), with what is known of
     // the blend's strays.
     SurfaceKind surface_for(const Params &params) const {
-        return surface_kind(params, points, noise, thin_walls, strays_found);
+        return surface_kind(params, points, noise, thin_walls, shell != nullptr, strays_found);
     }
 
     // The worker pool for `threads` (0: one per core): kept across stages, rebuilt only when

@@ -46,6 +46,7 @@ constexpr double kDenseGuideSpacings = 1.0;
 // more of the blend's strays past a thin part's end.
 constexpr double kThinWallGuideMinSlope = 0.5;
 
+
 // Clouds of more points are not tested for strays: the guiding solve's grid follows the
 // point spacing, and from a few hundred thousand points on it would take several times the
 // rest of the run.
@@ -79,20 +80,35 @@ int smooth_resolution(const Octree &tree, const PointMeasures &measures) {
 }
 
 SurfaceKind surface_kind(const Params &params, const PointSet &points, double noise, bool thin_walls,
-                         bool blend_strays) {
+                         bool thin_shell, bool blend_strays) {
     switch (params.surface) {
     case 0: return SurfaceKind::blend;
     case 1: return SurfaceKind::smooth;
     case 3: return SurfaceKind::guided_blend;
     default:
         if (noise_fraction(points, noise) >= kSmoothFromNoise) return SurfaceKind::smooth;
+        if (thin_shell) return SurfaceKind::shell;
         return !dense(points) || (!thin_walls && blend_strays) ? SurfaceKind::guided_blend : SurfaceKind::blend;
     }
 }
 
-bool strays_decide(const Params &params, const PointSet &points, double noise, bool thin_walls) {
-    return points.size() < kStrayTestBelowPoints && surface_kind(params, points, noise, thin_walls, false) !=
-           surface_kind(params, points, noise, thin_walls, true);
+bool strays_decide(const Params &params, const PointSet &points, double noise, bool thin_walls, bool thin_shell) {
+    return points.size() < kStrayTestBelowPoints && surface_kind(params, points, noise, thin_walls, thin_shell, false) !=
+           surface_kind(params, points, noise, thin_walls, thin_shell, true);
+}
+
+std::shared_ptr<const ShellField> thin_shell_reading(const PointSet &points, double noise, Workers &workers,
+                                                     Progress &progress) {
+    if (dense(points) || noise_fraction(points, noise) >= kSmoothFromNoise || !ShellField::may_be_shell(points)) {
+        progress.report(1.0);
+        return nullptr;
+    }
+    auto shell = std::make_shared<const ShellField>(points, workers, progress);
+    return shell->whole_shell() ? shell : nullptr;
+}
+
+int shell_resolution(const ShellField &shell, int default_grid) {
+    return std::clamp(std::max(default_grid, shell.grid()), 8, kMaxResolution);
 }
 
 Guide guide_for(const PointSet &points, const PointMeasures &measures, bool thin_walls) {
