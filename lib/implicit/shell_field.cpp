@@ -16,22 +16,22 @@ namespace {
 // points for a quadratic and the offset (7 unknowns) to leave residuals worth reading.
 constexpr size_t kNeighbours = 24;
 constexpr size_t kMinNeighbours = 12;
-// The gap must be this many residual deviations: on solids' neighbourhoods the split of the
-// shape's misfit reads 3-4, on noise-free walls 6 to thousands.
+// The gap must be this many residual deviations: on a solid's neighbourhood the split only
+// cuts the shape's own misfit, a few deviations apart, where a noise-free wall's two sheets
+// leave residuals far below their gap.
 constexpr double kSeparation = 6.0;
 // Nor a gap under this share of the spacing: the residuals of an exactly flat or curved
 // sheet are rounding, and rounding to float can split into two tidy groups.
 constexpr double kMinGapSpacings = 0.01;
-// The whole cloud is a shell when this share of its neighbourhoods read two sheets: solids
-// with thin parts (blades, fins, teeth) read up to a third, shells a half or more.
+// The whole cloud is a shell when this share of its neighbourhoods read two sheets: a solid
+// with thin parts (blades, fins, teeth) reads two sheets only on those, a shell nearly
+// everywhere but at its corners and rims.
 constexpr double kShellShare = 0.4;
-// Only walls thinner than this many sample spacings: wider ones the octree's two-sheet fits
-// resolve, and its blend follows them more closely than these patches (sheets 1.3-1.9
-// spacings apart lost 0.01-0.07 of F@0.5 % here; under 1.3 none lost more than 0.004).
+// Only walls thinner than this many sample spacings: the octree's two-sheet fits resolve
+// wider ones, and its blend follows them more closely than these patches.
 constexpr double kUnresolvedGap = 1.0;
 // The first look: this many points, evenly strided, and the share among them that lets the
-// whole cloud be read (a few standard errors of the sample under kShellShare; solids read
-// 0.0-0.15 except those with many thin parts, 0.2-0.35).
+// whole cloud be read (a few of the sample's standard errors under kShellShare).
 constexpr size_t kFirstLookPoints = 256;
 constexpr double kFirstLookShare = 0.25;
 // Split, refit, split again: the middle surface settles in a few rounds.

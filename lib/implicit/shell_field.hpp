@@ -3,8 +3,7 @@
 //
 // There every support of the octree holds points of both sheets, interleaved; the local fits
 // wander between them, orientation has no side to give a point, and the blend closes the
-// merged sheet into a blob (a 1,000-point ring came out a lumpy torus, its normals facing
-// into the wall). Yet each point's neighbourhood says plainly what it is: one smooth middle
+// merged sheet into a blob. Yet each point's neighbourhood says plainly what it is: one smooth middle
 // surface with every point a fixed distance a to one side of it or the other. Fitted so,
 //     z = q(x, y) ± a         (q a quadratic height over the neighbourhood's plane)
 // a noise-free wall leaves residuals far below the gap, where on a solid's surface the two

@@ -198,6 +198,78 @@ static void test_concurrent_evaluate_one_surface(void **state) {
     gmpu_surface_destroy(s);
 }
 
+/* ---- many threads, one thin shell: its field keeps what it has read (the rim test's
+ * lattice nodes), so the first queries from every thread at once write it ---- */
+
+enum { SHELL_POINTS = 1000, SHELL_QUERIES = 2000 };
+
+typedef struct {
+    const gmpu_surface *s;
+    const double *queries, *ref;
+    int id, mismatches, failures;
+    atomic_int *go;
+} shell_job;
+
+static void *shell_worker(void *arg) {
+    shell_job *j = arg;
+    double v[SHELL_QUERIES];
+    while (!atomic_load(j->go)) sched_yield();
+    const size_t chunk = 1 + (size_t)j->id * 37;
+    for (size_t done = 0; done < SHELL_QUERIES;) {
+        const size_t start = (done + (size_t)j->id * (SHELL_QUERIES / EVAL_THREADS)) % SHELL_QUERIES;
+        size_t count = chunk;
+        if (count > SHELL_QUERIES - done) count = SHELL_QUERIES - done;
+        if (count > SHELL_QUERIES - start) count = SHELL_QUERIES - start;
+        if (gmpu_surface_evaluate(j->s, j->queries + 3 * start, count, v + start, NULL) != GMPU_OK) ++j->failures;
+        done += count;
+    }
+    for (size_t i = 0; i < SHELL_QUERIES; ++i)
+        if (memcmp(&v[i], &j->ref[i], sizeof *v) != 0) ++j->mismatches;
+    return NULL;
+}
+
+static void test_concurrent_evaluate_thin_shell(void **state) {
+    (void)state;
+    /* A hollow sphere, radius 1, its wall 0.02 thick: at 1,000 points a thin shell. */
+    static double xyz[3 * SHELL_POINTS], queries[3 * SHELL_QUERIES], ref[SHELL_QUERIES];
+    robust_rng rng = {5};
+    for (size_t i = 0; i < SHELL_POINTS; ++i) {
+        double d[3];
+        robust_direction(&rng, d);
+        for (int k = 0; k < 3; ++k) xyz[3 * i + k] = (i % 2 ? 1.0 : 0.98) * d[k];
+    }
+    for (size_t i = 0; i < SHELL_QUERIES; ++i) {
+        double d[3];
+        robust_direction(&rng, d);
+        const double r = 0.99 + 0.03 * (2 * robust_uniform(&rng) - 1);
+        for (int k = 0; k < 3; ++k) queries[3 * i + k] = r * d[k];
+    }
+    /* The reference from a surface of its own, one thread; the threads share a fresh one. */
+    gmpu_surface *reference = oriented(xyz, SHELL_POINTS, 1), *s = oriented(xyz, SHELL_POINTS, 0);
+    assert_ok(gmpu_surface_evaluate(reference, queries, SHELL_QUERIES, ref, NULL));
+    /* Read as a shell: the wall is inside, the cavity outside (a solid sphere's would be in). */
+    const double wall[3] = {0.99, 0, 0}, cavity[3] = {0.5, 0, 0};
+    double f_wall = 0, f_cavity = 0;
+    assert_ok(gmpu_surface_evaluate(reference, wall, 1, &f_wall, NULL));
+    assert_ok(gmpu_surface_evaluate(reference, cavity, 1, &f_cavity, NULL));
+    assert_true(f_wall > 0 && f_cavity < 0);
+    atomic_int go = 0;
+    shell_job jobs[EVAL_THREADS];
+    pthread_t tid[EVAL_THREADS];
+    for (int t = 0; t < EVAL_THREADS; ++t) {
+        jobs[t] = (shell_job){s, queries, ref, t, 0, 0, &go};
+        assert_int_equal(pthread_create(&tid[t], NULL, shell_worker, &jobs[t]), 0);
+    }
+    atomic_store(&go, 1);
+    for (int t = 0; t < EVAL_THREADS; ++t) pthread_join(tid[t], NULL);
+    for (int t = 0; t < EVAL_THREADS; ++t) {
+        if (jobs[t].failures) fail_msg("thread %d: %d failed evaluations", t, jobs[t].failures);
+        if (jobs[t].mismatches) fail_msg("thread %d: %d values differ from a single thread's", t, jobs[t].mismatches);
+    }
+    gmpu_surface_destroy(reference);
+    gmpu_surface_destroy(s);
+}
+
 /* ---- one surface per thread ---- */
 
 typedef struct {
@@ -355,6 +427,7 @@ static void test_last_error_is_per_thread(void **state) {
 int main(void) {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_concurrent_evaluate_one_surface),
+        cmocka_unit_test(test_concurrent_evaluate_thin_shell),
         cmocka_unit_test(test_separate_surfaces_in_parallel),
         cmocka_unit_test(test_last_error_is_per_thread),
     };

@@ -34,16 +34,9 @@ def shell(outer, inner):
 
 
 def torus(major, minor, nu=128, nv=48, inward=False):
-    v = [((major + minor * np.cos(b)) * np.cos(a), (major + minor * np.cos(b)) * np.sin(a), minor * np.sin(b))
-         for a in 2 * np.pi * np.arange(nu) / nu for b in 2 * np.pi * np.arange(nv) / nv]
-    idx = lambda i, j: (i % nu) * nv + (j % nv)
-    f = []
-    for i in range(nu):
-        for j in range(nv):
-            a, b, c, d = idx(i, j), idx(i + 1, j), idx(i, j + 1), idx(i + 1, j + 1)
-            f += [(a, b, d), (a, d, c)]
-    f = np.array(f)
-    return np.array(v), f[:, ::-1] if inward else f
+    """A torus about z: its tube's circle revolved (lathe); inward: wound the other way."""
+    v, f = lathe([(major + minor * np.cos(b), minor * np.sin(b)) for b in 2 * np.pi * np.arange(nv) / nv], nu)
+    return v, f[:, ::-1] if inward else f
 
 
 def refine(profile, step=0.01):
