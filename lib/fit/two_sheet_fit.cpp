@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/median.hpp"
 #include "core/two_groups.hpp"
 
 namespace gmpu {
@@ -132,9 +133,8 @@ bool fit_sheets(const PointList &pts, std::vector<int> &label, double radius, Qu
         } else {
             std::vector<double> offset;
             for (const auto &p : group[small]) offset.push_back(part[big].value(p));
-            std::nth_element(offset.begin(), offset.begin() + long(offset.size() / 2), offset.end());
             part[small] = part[big];
-            part[small].c -= offset[offset.size() / 2];
+            part[small].c -= median_in_place(offset);
         }
         if (round == 2) break;
         for (size_t i = 0; i < pts.size(); ++i)

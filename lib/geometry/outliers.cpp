@@ -7,6 +7,7 @@
 
 #include <nanoflann.hpp>
 
+#include "core/median.hpp"
 #include "core/parallel.hpp"
 #include "core/progress.hpp"
 #include "geometry/counting_result_set.hpp"
@@ -100,8 +101,7 @@ OutlierScan find_outliers(const T *xyz, size_t count, size_t stride, bool only_i
         if (found == k + 1) kth.push_back(d2[k]);
     }
     if (kth.empty()) return scan;
-    std::nth_element(kth.begin(), kth.begin() + long(kth.size() / 2), kth.end());
-    const double spacing_sq = kth[kth.size() / 2];
+    const double spacing_sq = median_in_place(kth);
     scan.spacing = std::sqrt(spacing_sq);
     if (!(spacing_sq > 0.0) || !std::isfinite(spacing_sq)) return scan;  // duplicates; the caller decides
 

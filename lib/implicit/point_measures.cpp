@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/median.hpp"
 #include "core/resize_reporting.hpp"
 #include "implicit/on_sheet_normal.hpp"
 
@@ -36,11 +37,11 @@ constexpr size_t kExactMeasureLimit = 1u << 17;
 void shrink_sparse_trust(const PointSet &points, const std::vector<float> &normals, Workers &workers,
                          Progress &progress, std::vector<float> &trust_radius) {
     if (trust_radius.empty() || normals.size() != 3 * trust_radius.size()) return;
-    std::vector<float> sorted(trust_radius);
-    std::nth_element(sorted.begin(), sorted.begin() + long(sorted.size() / 2), sorted.end());
+    std::vector<float> radii(trust_radius);
+    const double median_trust = median_in_place(radii);
     const double diagonal = points.world_diagonal() * points.normalisation().scale;
     if (!(diagonal > 0.0)) return;
-    const double sparsity = double(sorted[sorted.size() / 2]) / kTrustSpacings / diagonal;
+    const double sparsity = median_trust / kTrustSpacings / diagonal;
     if (!(sparsity > kDenseSpacing)) return;
     const double t = std::min(1.0, (sparsity - kDenseSpacing) / (kSparseSpacing - kDenseSpacing));
     const float scale = float(1.0 - t * (1.0 - kSparseTrustSpacings / kTrustSpacings));

@@ -2,10 +2,12 @@
 
 #include <algorithm>
 #include <cmath>
+#include <queue>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 
+#include "core/median.hpp"
 #include "core/two_groups.hpp"
 
 namespace gmpu {
@@ -60,6 +62,12 @@ constexpr double kMaxReachRatio = 2.0;
 // outside the wall whatever the other patches say (they differ by a fraction of the gap):
 // they take that patch's value and skip the blend, most of the trusted space around a wall.
 constexpr double kBlendWithinHalfGaps = 3.0;
+// A patch that did not read two sheets weighs this much in the blend beside those that did:
+// enough to close a fold or a corner where no patch fits both faces, little enough that its
+// loose middle surface does not round them off further.
+constexpr double kMisfitWeight = 0.1;
+// Neighbours each patch's orientation is passed to.
+constexpr size_t kOrientNeighbours = 8;
 // Central differences for the gradient, in normalised units (the box spans 1).
 constexpr double kGradientStep = 1e-5;
 
@@ -134,11 +142,52 @@ ShellPatch fit_patch(const PointSet &points, size_t i) {
     return patch;
 }
 
-double median(std::vector<double> v) {
-    if (v.empty()) return 0.0;
-    std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
-    return v[v.size() / 2];
+// Turns the patches' middle normals to agree along the wall, as Hoppe et al. orient tangent
+// planes: over a spanning tree of the neighbour graph that keeps the most parallel pairs, so
+// the turn is passed around a fold (a box's edge) through the patches tilted between its
+// faces, never across it where the two faces' normals are perpendicular and either turn fits.
+// A wall's middle surface has a side even where the wall has no inside (a plate): the side
+// is only for blending heights, and any consistent choice serves.
+void orient_middles(const PointSet &points, Workers &workers, Progress &progress, std::vector<ShellPatch> &patches) {
+    const size_t count = patches.size();
+    std::vector<uint32_t> neighbours(count * kOrientNeighbours, UINT32_MAX);
+    parallel_for(0, count, workers, progress, [&](size_t i) {
+        thread_local std::vector<uint32_t> near;
+        thread_local std::vector<float> d2;
+        points.nearest(points.point(i), kOrientNeighbours + 1, near, d2);
+        size_t m = 0;
+        for (uint32_t j : near)
+            if (j != i && m < kOrientNeighbours) neighbours[i * kOrientNeighbours + m++] = j;
+    });
+    // Each neighbour pair is an edge both ways, so the tree can enter a patch from either end.
+    std::vector<std::vector<uint32_t>> edges(count);
+    for (size_t i = 0; i < count; ++i)
+        for (size_t m = 0; m < kOrientNeighbours; ++m) {
+            const uint32_t j = neighbours[i * kOrientNeighbours + m];
+            if (j == UINT32_MAX) continue;
+            edges[i].push_back(j);
+            edges[j].push_back(uint32_t(i));
+        }
+    std::vector<bool> done(count, false);
+    using Entry = std::pair<double, std::pair<uint32_t, uint32_t>>;  // |n·n'|, (from, to)
+    std::priority_queue<Entry> front;
+    for (size_t seed = 0; seed < count; ++seed) {
+        if (done[seed]) continue;
+        front.push({2.0, {uint32_t(seed), uint32_t(seed)}});
+        while (!front.empty()) {
+            const auto [from, to] = front.top().second;
+            front.pop();
+            if (done[to]) continue;
+            done[to] = true;
+            if (from != to && patches[from].orientation * patches[from].n.dot(patches[to].n) < 0.0)
+                patches[to].orientation = -1.0;
+            for (uint32_t next : edges[to])
+                if (!done[next]) front.push({std::fabs(patches[to].n.dot(patches[next].n)), {to, next}});
+        }
+    }
 }
+
+double median(std::vector<double> v) { return v.empty() ? 0.0 : median_in_place(v); }
 
 }  // namespace
 
@@ -154,6 +203,7 @@ ShellField::ShellField(const PointSet &points, Workers &workers, Progress &progr
     const size_t count = points.size();
     patches_.resize(count);
     parallel_for(0, count, workers, progress, [&](size_t i) { patches_[i] = fit_patch(points, i); });
+    orient_middles(points, workers, progress, patches_);
     std::vector<double> gaps, spacings, reaches;
     for (const ShellPatch &p : patches_) reaches.push_back(p.reach);
     const double reach_cap = kMaxReachRatio * median(reaches);
@@ -203,37 +253,35 @@ bool ShellField::blend(const PointSet &points, const Eigen::Vector3d &x, double 
     thread_local std::vector<float> d2;
     points.nearest(x, 1, near, d2);
     if (near.empty()) return false;
+    // Far off a wall's middle, the nearest patch alone says so; a patch that did not read two
+    // sheets (a fold, a corner) fits its neighbourhood too loosely to speak for the others.
     const ShellPatch &closest = patches_[near[0]];
     const double closest_height = std::fabs(closest.height(x));
-    if (closest_height > kBlendWithinHalfGaps * closest.half_gap && double(d2[0]) < closest.reach * closest.reach) {
+    if (closest.two_sheets && closest_height > kBlendWithinHalfGaps * closest.half_gap &&
+        double(d2[0]) < closest.reach * closest.reach) {
         f = closest.half_gap - closest_height;
         return true;
     }
     near.clear();
     points.within(x, widest_reach_ * (1.0 + 1e-5), near);
-    // Neighbourhoods that read two sheets carry the wall; the others only where none does.
-    // Heights are blended signed, each patch's turned to agree with the first one's side
-    // (which side that is does not matter: f takes |h|): blended unsigned, patches whose
-    // middles differ would thin the wall by their disagreement, and pierce it.
-    double gap[2] = {0.0, 0.0}, height[2] = {0.0, 0.0}, weight[2] = {0.0, 0.0};
-    const Eigen::Vector3d *across = nullptr;
+    // Heights are blended signed, each patch's turned to its orientation (which side that
+    // is does not matter: f takes |h|): blended unsigned, patches whose middles differ would
+    // thin the wall by their disagreement, and pierce it. For the same reason every patch
+    // within reach takes part, the misfits at a fold or corner too (at kMisfitWeight): left
+    // out, the faces' patches alone meet at the fold, each bent past it, and leave a gap.
+    double gap = 0.0, height = 0.0, weight = 0.0;
     for (uint32_t j : near) {
         const ShellPatch &p = patches_[j];
         const double t2 = (x - p.origin).squaredNorm() / (p.reach * p.reach);
         if (t2 >= 1.0) continue;
-        if (!across) across = &p.n;
-        const double w = (1.0 - t2) * (1.0 - t2) * (1.0 - t2);
-        const int kind = p.two_sheets ? 0 : 1;
-        gap[kind] += w * p.half_gap;
-        height[kind] += w * (p.n.dot(*across) < 0.0 ? -p.height(x) : p.height(x));
-        weight[kind] += w;
+        const double w = (1.0 - t2) * (1.0 - t2) * (1.0 - t2) * (p.two_sheets ? 1.0 : kMisfitWeight);
+        gap += w * p.half_gap;
+        height += w * p.orientation * p.height(x);
+        weight += w;
     }
-    for (int kind = 0; kind < 2; ++kind)
-        if (weight[kind] > 0.0) {
-            f = (gap[kind] - std::fabs(height[kind])) / weight[kind];
-            return true;
-        }
-    return false;
+    if (!(weight > 0.0)) return false;
+    f = (gap - std::fabs(height)) / weight;
+    return true;
 }
 
 double ShellField::within_rims(const PointSet &points, const Eigen::Vector3d &x) const {

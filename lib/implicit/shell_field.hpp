@@ -11,8 +11,11 @@
 // needs no orientation: a point's outward normal points away from the middle, to its side.
 //
 // The field is then the wall itself, the blend of every nearby patch's slab,
-//     f(x) = Σ wᵢ(x) (aᵢ − |hᵢ(x)|) / Σ wᵢ(x)
-// hᵢ the distance of x from patch i's middle surface: positive inside the wall, negative out.
+//     f(x) = (Σ wᵢ(x) aᵢ − |Σ wᵢ(x) sᵢ hᵢ(x)|) / Σ wᵢ(x)
+// hᵢ the height of x over patch i's middle surface and sᵢ = ±1 the patch's orientation,
+// passed from patch to patch along the wall so the heights agree in sign: f is positive
+// inside the wall, negative out. Round a fold or a corner (a box's edges) no patch reads two
+// sheets; those patches blend in at a tenth of the weight, which closes the wall there.
 // The patches reach a couple of spacings past the last points, and so would the wall, past
 // every rim of a plate or a pipe's end. So inside the wall f is also held under
 //     e(x) = τ R − |Pₜ(c(x) − x)|
@@ -49,6 +52,9 @@ struct ShellPatch {
     double spacing = 0.0;         // the neighbourhood's sample spacing, both sheets counted
     Eigen::Vector3d side_normal;  // unit, away from the middle, to the point's side
     bool two_sheets = false;      // separation reads a wall
+    // +1 or -1: turns n (and the heights along it) to agree with the neighbouring patches',
+    // so that heights blend with one sign across a whole connected wall.
+    double orientation = 1.0;
 
     // Signed height of x over the middle surface, along its normal (first order).
     double height(const Eigen::Vector3d &x) const;

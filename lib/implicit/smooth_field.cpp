@@ -9,6 +9,7 @@
 
 #include "core/block_sums.hpp"
 #include "core/error.hpp"
+#include "core/median.hpp"
 #include "core/memory_budget.hpp"
 #include "implicit/point_measures.hpp"
 
@@ -103,9 +104,7 @@ double sample_level(std::vector<double> &values, ZeroLevel level) {
         for (double v : values) sum += v;
         return sum / double(values.size());
     }
-    const auto middle = values.begin() + long(values.size() / 2);
-    std::nth_element(values.begin(), middle, values.end());
-    return *middle;
+    return median_in_place(values);
 }
 
 double weight(double d2, double r2) {

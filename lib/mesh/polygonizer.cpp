@@ -5,6 +5,7 @@
 #include <cmath>
 #include <string>
 
+#include "core/median.hpp"
 #include "core/memory_budget.hpp"
 #include "core/parallel.hpp"
 #include "mesh/block_grid.hpp"
@@ -216,9 +217,7 @@ double median_leaf_size(const Octree &tree) {
     std::vector<double> sizes;
     for (const Cell &c : tree.cells)
         if (c.is_sizing_leaf()) sizes.push_back(c.size);
-    if (sizes.empty()) return INFINITY;
-    std::nth_element(sizes.begin(), sizes.begin() + long(sizes.size() / 2), sizes.end());
-    return sizes[sizes.size() / 2];
+    return sizes.empty() ? INFINITY : median_in_place(sizes);
 }
 
 double thin_wall_gap(const Octree &tree) {

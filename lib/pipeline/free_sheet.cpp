@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/median.hpp"
+
 namespace gmpu {
 
 namespace {
@@ -53,11 +55,6 @@ void turn_normal(PointMeasures &measures, size_t i) {
     }
 }
 
-double median(std::vector<double> &v) {
-    std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
-    return v[v.size() / 2];
-}
-
 Eigen::Vector3d normal_of(const std::vector<float> &normals, uint32_t i) {
     return Eigen::Vector3d(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);
 }
@@ -75,7 +72,7 @@ bool is_free_sheet(const WindingField &winding, const PointSet &points, const st
         centre.push_back(reading.centre);
         jump.push_back(reading.jump);
     }
-    return SheetReading(median(centre), median(jump)).free(kFreeRatio);
+    return SheetReading(median_in_place(centre), median_in_place(jump)).free(kFreeRatio);
 }
 
 void split_sheet_faces(const MpuFunction &mpu, const PointSet &points, PointMeasures &measures, Workers &workers,

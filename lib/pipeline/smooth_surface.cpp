@@ -4,6 +4,7 @@
 #include <cmath>
 #include <vector>
 
+#include "core/median.hpp"
 #include "mesh/polygonizer.hpp"
 #include "pipeline/smooth_normals.hpp"
 
@@ -63,9 +64,7 @@ double noise_fraction(const PointSet &points, double noise) {
 // without areas).
 double median_spacing(const PointMeasures &measures) {
     std::vector<float> area(measures.area);
-    if (area.empty()) return 0.0;
-    std::nth_element(area.begin(), area.begin() + long(area.size() / 2), area.end());
-    return std::sqrt(double(area[area.size() / 2]));
+    return area.empty() ? 0.0 : std::sqrt(double(median_in_place(area)));
 }
 }  // namespace
 
