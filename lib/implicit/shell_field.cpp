@@ -207,8 +207,10 @@ ShellField::ShellField(const PointSet &points, Workers &workers, Progress &progr
     std::vector<double> gaps, spacings, reaches;
     for (const ShellPatch &p : patches_) reaches.push_back(p.reach);
     const double reach_cap = kMaxReachRatio * median(reaches);
+    balls_.reserve(count);
     for (ShellPatch &p : patches_) {
         p.reach = std::min(p.reach, reach_cap);
+        balls_.emplace_back(p.origin[0], p.origin[1], p.origin[2], p.reach * p.reach);
         widest_reach_ = std::max(widest_reach_, p.reach);
         spacings.push_back(p.spacing);
         if (p.two_sheets) gaps.push_back(2.0 * p.half_gap);
@@ -248,39 +250,55 @@ bool ShellField::whole_shell() const {
     return two_sheet_share_ >= kShellShare && median_gap_ < kUnresolvedGap * median_spacing_;
 }
 
-bool ShellField::blend(const PointSet &points, const Eigen::Vector3d &x, double &f) const {
-    thread_local std::vector<uint32_t> near;
-    thread_local std::vector<float> d2;
-    points.nearest(x, 1, near, d2);
-    if (near.empty()) return false;
+void ShellField::gather(const PointSet &points, const Eigen::Vector3d &centre, double radius,
+                        std::vector<uint32_t> &patches) const {
+    patches.clear();
+    points.within(centre, radius + widest_reach_ * (1.0 + 1e-5), patches);
+    std::sort(patches.begin(), patches.end());
+}
+
+bool ShellField::value_among(const PointSet &points, const std::vector<uint32_t> &patches, const Eigen::Vector3d &x,
+                             double &f) const {
+    // One pass over the candidates: the nearest, and those whose reach holds x.
+    thread_local std::vector<std::pair<uint32_t, double>> reaching;
+    reaching.clear();
+    uint32_t closest = 0;
+    double closest_d2 = INFINITY;
+    for (uint32_t j : patches) {
+        const Eigen::Vector4d &ball = balls_[j];
+        const double dx = ball[0] - x[0], dy = ball[1] - x[1], dz = ball[2] - x[2];
+        const double d2 = dx * dx + dy * dy + dz * dz;
+        if (d2 < closest_d2) closest = j, closest_d2 = d2;
+        if (d2 < ball[3]) reaching.emplace_back(j, d2);
+    }
+    if (reaching.empty()) return false;
     // Far off a wall's middle, the nearest patch alone says so; a patch that did not read two
     // sheets (a fold, a corner) fits its neighbourhood too loosely to speak for the others.
-    const ShellPatch &closest = patches_[near[0]];
-    const double closest_height = std::fabs(closest.height(x));
-    if (closest.two_sheets && closest_height > kBlendWithinHalfGaps * closest.half_gap &&
-        double(d2[0]) < closest.reach * closest.reach) {
-        f = closest.half_gap - closest_height;
-        return true;
+    const ShellPatch &nearest = patches_[closest];
+    const double nearest_height = std::fabs(nearest.height(x));
+    if (nearest.two_sheets && nearest_height > kBlendWithinHalfGaps * nearest.half_gap &&
+        closest_d2 < balls_[closest][3]) {
+        f = nearest.half_gap - nearest_height;
+    } else {
+        // Heights are blended signed, each patch's turned to its orientation (which side that
+        // is does not matter: f takes |h|): blended unsigned, patches whose middles differ
+        // would thin the wall by their disagreement, and pierce it. For the same reason every
+        // patch within reach takes part, the misfits at a fold or corner too (at
+        // kMisfitWeight): left out, the faces' patches alone meet at the fold, each bent past
+        // it, and leave a gap.
+        double gap = 0.0, height = 0.0, weight = 0.0;
+        for (const auto &[j, d2] : reaching) {
+            const ShellPatch &p = patches_[j];
+            const double t = 1.0 - d2 / balls_[j][3];
+            const double w = t * t * t * (p.two_sheets ? 1.0 : kMisfitWeight);
+            gap += w * p.half_gap;
+            height += w * p.orientation * p.height(x);
+            weight += w;
+        }
+        f = (gap - std::fabs(height)) / weight;
     }
-    near.clear();
-    points.within(x, widest_reach_ * (1.0 + 1e-5), near);
-    // Heights are blended signed, each patch's turned to its orientation (which side that
-    // is does not matter: f takes |h|): blended unsigned, patches whose middles differ would
-    // thin the wall by their disagreement, and pierce it. For the same reason every patch
-    // within reach takes part, the misfits at a fold or corner too (at kMisfitWeight): left
-    // out, the faces' patches alone meet at the fold, each bent past it, and leave a gap.
-    double gap = 0.0, height = 0.0, weight = 0.0;
-    for (uint32_t j : near) {
-        const ShellPatch &p = patches_[j];
-        const double t2 = (x - p.origin).squaredNorm() / (p.reach * p.reach);
-        if (t2 >= 1.0) continue;
-        const double w = (1.0 - t2) * (1.0 - t2) * (1.0 - t2) * (p.two_sheets ? 1.0 : kMisfitWeight);
-        gap += w * p.half_gap;
-        height += w * p.orientation * p.height(x);
-        weight += w;
-    }
-    if (!(weight > 0.0)) return false;
-    f = (gap - std::fabs(height)) / weight;
+    // Outside the slab f is negative already; the rims only cut it.
+    if (f > 0.0) f = std::min(f, within_rims(points, x));
     return true;
 }
 
@@ -342,10 +360,11 @@ double ShellField::rim_at_node(const PointSet &points, const Eigen::Vector3d &x)
 }
 
 double ShellField::wall(const PointSet &points, const Eigen::Vector3d &x, bool &defined) const {
+    thread_local std::vector<uint32_t> near;
+    gather(points, x, 0.0, near);
     double f = 0.0;
-    defined = blend(points, x, f);
-    // Outside the slab f is negative already; the rims only cut it.
-    return defined && f > 0.0 ? std::min(f, within_rims(points, x)) : f;
+    defined = value_among(points, near, x, f);
+    return f;
 }
 
 bool ShellField::value(const PointSet &points, const Eigen::Vector3d &x, double &f, Eigen::Vector3d *gradient) const {

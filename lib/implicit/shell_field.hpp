@@ -90,13 +90,21 @@ public:
     // asked, by central differences. `points`: the set the field was fitted to.
     bool value(const PointSet &points, const Eigen::Vector3d &x, double &f, Eigen::Vector3d *gradient) const;
 
+    // The patches that may reach into the ball (centre, radius), in index order: gathered
+    // once for a block of queries, they spare each query its own neighbour searches.
+    void gather(const PointSet &points, const Eigen::Vector3d &centre, double radius,
+                std::vector<uint32_t> &patches) const;
+    // f at x as value() gives it (without the gradient), from `patches` (gather()'s for a
+    // ball that holds x): the same patches take part, in the same order.
+    bool value_among(const PointSet &points, const std::vector<uint32_t> &patches, const Eigen::Vector3d &x,
+                     double &f) const;
+
     // Point i's outward normal: −∇f there, the wall's own (on a rim face it points past the
     // rim, where every patch's middle surface only knows the two faces); its patch's side
     // normal where f is flat.
     Eigen::Vector3d outward_normal(const PointSet &points, size_t i) const;
 
 private:
-    bool blend(const PointSet &points, const Eigen::Vector3d &x, double &f) const;
     // e(x): positive within the sampled sheets, negative past their rims; at a lattice node,
     // and interpolated between them.
     double rim_at_node(const PointSet &points, const Eigen::Vector3d &x) const;
@@ -104,6 +112,8 @@ private:
     double wall(const PointSet &points, const Eigen::Vector3d &x, bool &defined) const;
 
     std::vector<ShellPatch> patches_;
+    // Each patch's origin and squared reach, packed for the scans over candidates.
+    std::vector<Eigen::Vector4d> balls_;
     double widest_reach_ = 0.0;
     double two_sheet_share_ = 0.0, median_gap_ = 0.0, median_spacing_ = 0.0;
     double rim_step_ = 0.0;

@@ -131,13 +131,23 @@ void SurfaceField::block_values(const LatticeBlock &block, const uint32_t *near,
         }
         return coarse[c];
     };
+    // The thin shell's patches for the whole block, gathered once: every corner's query
+    // would search nearly the same neighbourhood again.
+    thread_local std::vector<uint32_t> shell_patches;
+    if (shell_) {
+        const Eigen::Vector3d centre = block.corner(0, 0, 0) + 0.5 * block.h * Eigen::Vector3d::Constant(n);
+        shell_->gather(points_, centre, 0.5 * std::sqrt(3.0) * block.h * n * (1.0 + 1e-9), shell_patches);
+    }
     for (int k = 0; k < C; ++k)
         for (int j = 0; j < C; ++j)
             for (int i = 0; i < C; ++i) {
                 const size_t at = local(i, j, k);
                 if (skip && skip[at]) continue;
                 double v;
-                if (trusted[at]) {
+                if (trusted[at] && shell_) {
+                    const Eigen::Vector3d x = block.corner(i, j, k);
+                    if (!shell_->value_among(points_, shell_patches, x, v)) v = far_value(x, nullptr);
+                } else if (trusted[at]) {
                     v = trusted_value(block.leaves_at(i, j, k), block.corner(i, j, k), nullptr);
                 } else if (smooth_beyond_trust() && smooth_->value(block.corner(i, j, k), v, nullptr)) {
                     // Untrusted, but inside the smooth field's box: its value, as in value().

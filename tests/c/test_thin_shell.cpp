@@ -160,6 +160,37 @@ void surface_parameter_changed_after_orient_to_and_from_the_shell(void **) {
     assert_true(back.vertices == automatic.mesh.vertices && back.triangles == automatic.mesh.triangles);
 }
 
+void a_blocks_gathered_patches_give_each_corner_its_own_value(void **) {
+    // The polygonizer gathers the patches once for a block of corners and each corner scans
+    // that list: every corner must get exactly what a query of its own gets (the blocks that
+    // share a corner then agree, and the mesh is the field's), a patch missed or summed in
+    // another order would show.
+    std::vector<double> xyz;
+    for (const Vec3 &p : sample_mesh(hollow_sphere(), kSparse, 19).positions) xyz.insert(xyz.end(), {p.x(), p.y(), p.z()});
+    const gmpu::PointSet set = gmpu::PointSet::from_array(xyz.data(), xyz.size() / 3, 3 * sizeof(double), 1);
+    gmpu::Workers workers(1);
+    gmpu::Progress progress(nullptr, nullptr, GMPU_STAGE_FIT);
+    const gmpu::ShellField shell(set, workers, progress);
+    // 9³ corners 0.01 apart (normalised units: the wall is 0.02 thick), astride the wall.
+    const Eigen::Vector3d centre = set.point(0), first = centre - Eigen::Vector3d::Constant(0.04);
+    std::vector<uint32_t> patches;
+    shell.gather(set, centre, std::sqrt(3.0) * 0.04, patches);
+    size_t defined = 0, inside = 0;
+    for (int k = 0; k <= 8; ++k)
+        for (int j = 0; j <= 8; ++j)
+            for (int i = 0; i <= 8; ++i) {
+                const Eigen::Vector3d x = first + 0.01 * Eigen::Vector3d(i, j, k);
+                double own = 0.0, among = 0.0;
+                const bool has_own = shell.value(set, x, own, nullptr);
+                assert_int_equal(has_own, shell.value_among(set, patches, x, among));
+                if (!has_own) continue;
+                assert_true(own == among);
+                ++defined, inside += own > 0.0;
+            }
+    print_message("block: %zu of 729 corners defined, %zu inside the wall\n", defined, inside);
+    assert_true(defined > 400 && inside > 0);
+}
+
 void solids_and_resolved_walls_are_not_shells(void **) {
     // A solid torus sampled as sparsely: its neighbourhoods show one sheet.
     const gmpu::ShellField torus = shell_reading(sample_mesh(torus_mesh(0.4, 0.15, 64, 32), kSparse, 17).positions);
@@ -183,6 +214,7 @@ int main() {
         cmocka_unit_test(sparse_hollow_box_keeps_its_wall_round_edges_and_corners),
         cmocka_unit_test(sparse_plate_ends_at_its_rim),
         cmocka_unit_test(surface_parameter_changed_after_orient_to_and_from_the_shell),
+        cmocka_unit_test(a_blocks_gathered_patches_give_each_corner_its_own_value),
         cmocka_unit_test(solids_and_resolved_walls_are_not_shells),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
