@@ -79,12 +79,19 @@ Row height_terms(double x, double y) {
     return r;
 }
 
-ShellPatch fit_patch(const PointSet &points, size_t i) {
+// `nearest`, if given, receives the kOrientNeighbours points nearest point i (UINT32_MAX
+// where there are fewer).
+ShellPatch fit_patch(const PointSet &points, size_t i, uint32_t *nearest = nullptr) {
     ShellPatch patch;
     patch.origin = points.point(i);
     thread_local std::vector<uint32_t> near;
     thread_local std::vector<float> d2;
     points.nearest(patch.origin, kNeighbours, near, d2);
+    if (nearest) {
+        size_t m = 0;
+        for (uint32_t j : near)
+            if (j != i && m < kOrientNeighbours) nearest[m++] = j;
+    }
     const size_t k = near.size();
     const double radius = std::sqrt(double(d2.empty() ? 0.0f : d2.back()));
     patch.reach = kReachScale * radius;
@@ -143,22 +150,14 @@ ShellPatch fit_patch(const PointSet &points, size_t i) {
 }
 
 // Turns the patches' middle normals to agree along the wall, as Hoppe et al. orient tangent
-// planes: over a spanning tree of the neighbour graph that keeps the most parallel pairs, so
-// the turn is passed around a fold (a box's edge) through the patches tilted between its
-// faces, never across it where the two faces' normals are perpendicular and either turn fits.
+// planes: over a spanning tree of the neighbour graph (`neighbours`: kOrientNeighbours per
+// patch, from fit_patch) that keeps the most parallel pairs, so the turn is passed around a
+// fold (a box's edge) through the patches tilted between its faces, never across it where
+// the two faces' normals are perpendicular and either turn fits.
 // A wall's middle surface has a side even where the wall has no inside (a plate): the side
 // is only for blending heights, and any consistent choice serves.
-void orient_middles(const PointSet &points, Workers &workers, Progress &progress, std::vector<ShellPatch> &patches) {
+void orient_middles(const std::vector<uint32_t> &neighbours, std::vector<ShellPatch> &patches) {
     const size_t count = patches.size();
-    std::vector<uint32_t> neighbours(count * kOrientNeighbours, UINT32_MAX);
-    parallel_for(0, count, workers, progress, [&](size_t i) {
-        thread_local std::vector<uint32_t> near;
-        thread_local std::vector<float> d2;
-        points.nearest(points.point(i), kOrientNeighbours + 1, near, d2);
-        size_t m = 0;
-        for (uint32_t j : near)
-            if (j != i && m < kOrientNeighbours) neighbours[i * kOrientNeighbours + m++] = j;
-    });
     // Each neighbour pair is an edge both ways, so the tree can enter a patch from either end.
     std::vector<std::vector<uint32_t>> edges(count);
     for (size_t i = 0; i < count; ++i)
@@ -202,8 +201,10 @@ double ShellPatch::height(const Eigen::Vector3d &x) const {
 ShellField::ShellField(const PointSet &points, Workers &workers, Progress &progress) {
     const size_t count = points.size();
     patches_.resize(count);
-    parallel_for(0, count, workers, progress, [&](size_t i) { patches_[i] = fit_patch(points, i); });
-    orient_middles(points, workers, progress, patches_);
+    std::vector<uint32_t> neighbours(count * kOrientNeighbours, UINT32_MAX);
+    parallel_for(0, count, workers, progress,
+                 [&](size_t i) { patches_[i] = fit_patch(points, i, &neighbours[i * kOrientNeighbours]); });
+    orient_middles(neighbours, patches_);
     std::vector<double> gaps, spacings, reaches;
     for (const ShellPatch &p : patches_) reaches.push_back(p.reach);
     const double reach_cap = kMaxReachRatio * median(reaches);
@@ -359,24 +360,17 @@ double ShellField::rim_at_node(const PointSet &points, const Eigen::Vector3d &x)
     return kRimOffset * reach - behind.norm();
 }
 
-double ShellField::wall(const PointSet &points, const Eigen::Vector3d &x, bool &defined) const {
-    thread_local std::vector<uint32_t> near;
-    gather(points, x, 0.0, near);
-    double f = 0.0;
-    defined = value_among(points, near, x, f);
-    return f;
-}
-
 bool ShellField::value(const PointSet &points, const Eigen::Vector3d &x, double &f, Eigen::Vector3d *gradient) const {
-    bool defined = false;
-    f = wall(points, x, defined);
-    if (!defined) return false;
+    // One gather serves x and the six samples of its gradient.
+    thread_local std::vector<uint32_t> near;
+    gather(points, x, gradient ? kGradientStep : 0.0, near);
+    if (!value_among(points, near, x, f)) return false;
     if (gradient) {
         for (int d = 0; d < 3; ++d) {
             Eigen::Vector3d step = Eigen::Vector3d::Zero();
             step[d] = kGradientStep;
-            bool has_hi = false, has_lo = false;
-            double hi = wall(points, x + step, has_hi), lo = wall(points, x - step, has_lo);
+            double hi = 0.0, lo = 0.0;
+            const bool has_hi = value_among(points, near, x + step, hi), has_lo = value_among(points, near, x - step, lo);
             if (!has_hi) hi = f;
             if (!has_lo) lo = f;
             (*gradient)[d] = (hi - lo) / ((has_hi ? kGradientStep : 0.0) + (has_lo ? kGradientStep : 0.0) + 1e-300);

@@ -109,7 +109,6 @@ private:
     // and interpolated between them.
     double rim_at_node(const PointSet &points, const Eigen::Vector3d &x) const;
     double within_rims(const PointSet &points, const Eigen::Vector3d &x) const;
-    double wall(const PointSet &points, const Eigen::Vector3d &x, bool &defined) const;
 
     std::vector<ShellPatch> patches_;
     // Each patch's origin and squared reach, packed for the scans over candidates.
