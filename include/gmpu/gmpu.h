@@ -183,12 +183,14 @@ typedef enum gmpu_param {
      * sample spacings from every point: a lump past a sparse foot, a bridge), there with the
      * smooth implicit on a grid twice as coarse and held to within one spacing; else 0. But a
      * cloud of fewer than 20,000 points with no estimated noise whose neighbourhoods read as
-     * two sheets under a sample spacing apart nearly everywhere (a thin shell: a hollow box, a
-     * pipe, a plate) gets that wall instead: the slab between the two sheets its points lie
-     * on, ended where they end, each point's normal facing away from the wall's middle. Read
-     * by orient (which makes that test's mesh, handed out by the next polygonize if the blend
-     * stays the surface, and solves the smooth implicit) and polygonize (which tests, solves
-     * or drops them if the value changed since). Default 2, range 0..3. */
+     * two sheets under a sample spacing apart in two of five (in one of five where they are
+     * under 0.6 of a spacing apart) (a thin shell: a hollow box, a pipe, a plate; a part that
+     * is mostly blades that thin) gets that wall instead: the slab between the two sheets its
+     * points lie on, ended where they end, each point's normal facing away from the wall's
+     * middle. Read by orient (which makes that test's mesh, handed out by the next
+     * polygonize if the blend stays the surface, and solves the smooth implicit) and
+     * polygonize (which tests, solves or drops them if the value changed since).
+     * Default 2, range 0..3. */
     GMPU_PARAM_SURFACE = 14
 } gmpu_param;
 

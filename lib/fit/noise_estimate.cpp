@@ -32,6 +32,11 @@ constexpr double kBallPerNoise = 5.0;  // ball radius wanted, in estimated σ
 // apart are two sheets (a thin wall), not noise: a Gaussian sample of 24 splits by less.
 constexpr double kSheetSeparation = 5.5;
 constexpr size_t kSheetMinSide = 4;
+// A split this many pooled deviations apart is a noise-free wall's (noise of a few σ between
+// sheets splits, if at all, just past kSheetSeparation): only then is a ball whose centre's
+// sheet came out short taken again twice as large. At noise the larger ball lets the other
+// sheet's tail in, and the centres that split are few and a biased share of the noise.
+constexpr double kCleanSplit = 12.0;
 // The residuals are read at this quantile over the centres (z its standard normal score):
 // noise is everywhere, while the residual of a shape too sparsely sampled for its detail
 // (gear teeth, creases) is where that detail is, so a low quantile reads the noise alone.
@@ -140,8 +145,8 @@ double two_means(const std::vector<double> &residuals, size_t count, double &sep
 // kFar hold two. A fit through both sheets lies between them and is tilted by whichever
 // holds more points, which blurs the two groups of residuals; refitted to the centre's
 // group alone, the other sheet stands a full wall thickness off, while a noisy single sheet
-// still reads as one group.
-void keep_centre_sheet(std::vector<Local> &pts, double scale) {
+// still reads as one group. Returns the split's separation (0 when nothing was cut).
+double keep_centre_sheet(std::vector<Local> &pts, double scale) {
     thread_local std::vector<double> residuals;
     thread_local std::vector<Local> side;
     fit_height(std::vector<Local>(pts.begin(), pts.begin() + long(kFar)), 6, scale, pts, residuals);
@@ -152,12 +157,13 @@ void keep_centre_sheet(std::vector<Local> &pts, double scale) {
         if ((residuals[k] > split) == (residuals[0] > split)) side.push_back(pts[k]);
     fit_height(side, side.size() >= 12 ? 6 : 3, scale, pts, residuals);
     split = two_means(residuals, kFar, separation);
-    if (!(separation > kSheetSeparation)) return;
+    if (!(separation > kSheetSeparation)) return 0.0;
     size_t kept = 0;
     const bool above = residuals[0] > split;
     for (size_t k = 0; k < pts.size(); ++k)
         if ((residuals[k] > split) == above) pts[kept++] = pts[k];
     pts.resize(kept);
+    return separation;
 }
 
 struct Scales {
@@ -199,22 +205,30 @@ Scales measure(const PointSet &points, size_t ball, size_t centres, Progress &pr
     for (size_t i = 0; i < n; i += step) {
         progress.tick();
         const Eigen::Vector3d centre = points.point(i);
-        points.nearest(centre, ball, idx, d2);
-        if (idx.size() < kFar) continue;
-        const double r = std::sqrt(double(d2.back()));
-        if (!(r > 0.0)) continue;
-        local.clear();
-        for (uint32_t j : idx) local.push_back(points.point(j) - centre);
-        const Pca pca = compute_pca(local);
-        const Eigen::Vector3d t1 = pca.axes.col(2), t2 = pca.axes.col(1), nrm = pca.axes.col(0);
-        pts.clear();
-        for (const auto &p : local) {
-            double u = p.dot(t1), v = p.dot(t2);
-            pts.push_back({u, v, p.dot(nrm), u * u + v * v});
+        double r = 0.0;
+        // A ball on a wall holds both sheets, the centre's only about half of it: where that
+        // half is short of kFar after a clean split, the ball is taken twice as large once.
+        // Skipped instead, a sparse thin-walled cloud would be read only where its sheets do
+        // not split (folds, rims) and its shape there taken for noise.
+        for (size_t wanted = ball; wanted <= 2 * ball; wanted *= 2) {
+            points.nearest(centre, std::min(wanted, n), idx, d2);
+            pts.clear();
+            if (idx.size() < kFar) break;
+            r = std::sqrt(double(d2.back()));
+            if (!(r > 0.0)) break;
+            local.clear();
+            for (uint32_t j : idx) local.push_back(points.point(j) - centre);
+            const Pca pca = compute_pca(local);
+            const Eigen::Vector3d t1 = pca.axes.col(2), t2 = pca.axes.col(1), nrm = pca.axes.col(0);
+            for (const auto &p : local) {
+                double u = p.dot(t1), v = p.dot(t2);
+                pts.push_back({u, v, p.dot(nrm), u * u + v * v});
+            }
+            auto by_tangential = [](const Local &a, const Local &b) { return a.t2 < b.t2; };
+            std::sort(pts.begin(), pts.end(), by_tangential);
+            const double separation = keep_centre_sheet(pts, r);
+            if (pts.size() >= kFar || separation < kCleanSplit) break;
         }
-        auto by_tangential = [](const Local &a, const Local &b) { return a.t2 < b.t2; };
-        std::sort(pts.begin(), pts.end(), by_tangential);
-        keep_centre_sheet(pts, r);
         if (pts.size() < kFar) continue;
         fit_height(std::vector<Local>(pts.begin(), pts.begin() + long(kNear)), 6, r, pts, residuals);
         near.push_back(unbiased_rms(residuals, kNear));

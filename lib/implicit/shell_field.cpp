@@ -32,10 +32,16 @@ constexpr double kShellShare = 0.4;
 // Only walls thinner than this many sample spacings: the octree's two-sheet fits resolve
 // wider ones, and its blend follows them more closely than these patches.
 constexpr double kUnresolvedGap = 1.0;
+// Walls far thinner than that, under kThinWallGap spacings, need only kThinWallShare: a
+// box-like shell at 1,000 points reads two sheets on its faces' middles alone (every other
+// neighbourhood crosses a fold), and a part that is mostly blades that thin (a rotor at
+// 1,000 points) is better drawn as walls than by the blend, which merges them.
+constexpr double kThinWallGap = 0.6;
+constexpr double kThinWallShare = 0.2;
 // The first look: this many points, evenly strided, and the share among them that lets the
-// whole cloud be read (a few of the sample's standard errors under kShellShare).
+// whole cloud be read (a few of the sample's standard errors under kThinWallShare).
 constexpr size_t kFirstLookPoints = 256;
-constexpr double kFirstLookShare = 0.25;
+constexpr double kFirstLookShare = 0.12;
 // Split, refit, split again: the middle surface settles in a few rounds.
 constexpr int kRounds = 3;
 constexpr size_t kMinSide = 3;
@@ -248,7 +254,9 @@ int ShellField::grid() const {
 }
 
 bool ShellField::whole_shell() const {
-    return two_sheet_share_ >= kShellShare && median_gap_ < kUnresolvedGap * median_spacing_;
+    if (!(median_gap_ < kUnresolvedGap * median_spacing_)) return false;
+    return two_sheet_share_ >= kShellShare ||
+           (two_sheet_share_ >= kThinWallShare && median_gap_ < kThinWallGap * median_spacing_);
 }
 
 void ShellField::gather(const PointSet &points, const Eigen::Vector3d &centre, double radius,

@@ -83,7 +83,7 @@ public:
     // The median sample spacing of the neighbourhoods, both sheets counted.
     double median_spacing() const { return median_spacing_; }
     // Whether the whole cloud reads as a thin shell: two sheets in enough of its
-    // neighbourhoods, under a sample spacing apart.
+    // neighbourhoods, under a sample spacing apart (in fewer of them where far thinner).
     bool whole_shell() const;
 
     // f at x (positive inside the wall); false where no patch reaches x. The gradient, if
