@@ -74,6 +74,12 @@ constexpr double kBlendWithinHalfGaps = 3.0;
 constexpr double kMisfitWeight = 0.1;
 // Neighbours each patch's orientation is passed to.
 constexpr size_t kOrientNeighbours = 8;
+// A two-sheet patch that puts a point within this many half gaps of its middle surface does
+// not say which sheet the point is on.
+constexpr double kSideVoteHalfGaps = 0.3;
+// The side vote overrides −∇f only where the two are further apart than 120° (cosine below
+// minus this).
+constexpr double kSideVoteAgreement = 0.5;
 // Central differences for the gradient, in normalised units (the box spans 1).
 constexpr double kGradientStep = 1e-5;
 
@@ -243,10 +249,28 @@ bool ShellField::may_be_shell(const PointSet &points) {
 }
 
 Eigen::Vector3d ShellField::outward_normal(const PointSet &points, size_t i) const {
+    const Eigen::Vector3d x = points.point(i);
     double f = 0.0;
     Eigen::Vector3d g = Eigen::Vector3d::Zero();
-    if (value(points, points.point(i), f, &g) && g.norm() > 0.0) return -g.normalized();
-    return patches_[i].side_normal;
+    if (!(value(points, x, f, &g) && g.norm() > 0.0)) return patches_[i].side_normal;
+    g = -g.normalized();
+    // Near a fold the blended middle surface is bent, and a point can fall on the wrong side
+    // of it. The two-sheet patches reaching the point each read which sheet it lies on; where
+    // their weighted vote points nearly opposite −∇f, the vote wins. On a rim face −∇f points
+    // past the rim, across the vote, and is kept.
+    thread_local std::vector<uint32_t> near;
+    gather(points, x, 0.0, near);
+    Eigen::Vector3d vote = Eigen::Vector3d::Zero();
+    for (uint32_t j : near) {
+        const ShellPatch &p = patches_[j];
+        const double r2 = (x - p.origin).squaredNorm(), reach2 = balls_[j][3];
+        if (!p.two_sheets || r2 >= reach2) continue;
+        const double h = p.height(x);
+        if (std::fabs(h) < kSideVoteHalfGaps * p.half_gap) continue;
+        const double t = 1.0 - r2 / reach2;
+        vote += t * t * t * (h > 0.0 ? p.n : Eigen::Vector3d(-p.n));
+    }
+    return vote.dot(g) < -kSideVoteAgreement * vote.norm() ? Eigen::Vector3d(-g) : g;
 }
 
 int ShellField::grid() const {

@@ -100,8 +100,9 @@ public:
                      double &f) const;
 
     // Point i's outward normal: −∇f there, the wall's own (on a rim face it points past the
-    // rim, where every patch's middle surface only knows the two faces); its patch's side
-    // normal where f is flat.
+    // rim, where every patch's middle surface only knows the two faces), turned over where
+    // the two-sheet patches reaching the point read it on the other sheet (near a fold); its
+    // patch's side normal where f is flat.
     Eigen::Vector3d outward_normal(const PointSet &points, size_t i) const;
 
 private:
