@@ -250,18 +250,23 @@ bool ShellField::may_be_shell(const PointSet &points) {
 
 Eigen::Vector3d ShellField::outward_normal(const PointSet &points, size_t i) const {
     const Eigen::Vector3d x = points.point(i);
+    // One gather serves f, its gradient and the side vote.
+    thread_local std::vector<uint32_t> near;
+    gather(points, x, kGradientStep, near);
     double f = 0.0;
     Eigen::Vector3d g = Eigen::Vector3d::Zero();
-    if (!(value(points, x, f, &g) && g.norm() > 0.0)) return patches_[i].side_normal;
+    if (!(value_among(points, near, x, f, &g) && g.norm() > 0.0)) return patches_[i].side_normal;
     g = -g.normalized();
     // Near a fold the blended middle surface is bent, and a point can fall on the wrong side
-    // of it. The two-sheet patches reaching the point each read which sheet it lies on; where
-    // their weighted vote points nearly opposite −∇f, the vote wins. On a rim face −∇f points
-    // past the rim, across the vote, and is kept.
-    thread_local std::vector<uint32_t> near;
-    gather(points, x, 0.0, near);
+    // of it; where the side vote points nearly opposite −∇f, the vote wins. On a rim face −∇f
+    // points past the rim, across the vote, and is kept.
+    const Eigen::Vector3d vote = side_vote(near, x);
+    return vote.dot(g) < -kSideVoteAgreement * vote.norm() ? Eigen::Vector3d(-g) : g;
+}
+
+Eigen::Vector3d ShellField::side_vote(const std::vector<uint32_t> &patches, const Eigen::Vector3d &x) const {
     Eigen::Vector3d vote = Eigen::Vector3d::Zero();
-    for (uint32_t j : near) {
+    for (uint32_t j : patches) {
         const ShellPatch &p = patches_[j];
         const double r2 = (x - p.origin).squaredNorm(), reach2 = balls_[j][3];
         if (!p.two_sheets || r2 >= reach2) continue;
@@ -270,7 +275,7 @@ Eigen::Vector3d ShellField::outward_normal(const PointSet &points, size_t i) con
         const double t = 1.0 - r2 / reach2;
         vote += t * t * t * (h > 0.0 ? p.n : Eigen::Vector3d(-p.n));
     }
-    return vote.dot(g) < -kSideVoteAgreement * vote.norm() ? Eigen::Vector3d(-g) : g;
+    return vote;
 }
 
 int ShellField::grid() const {
@@ -396,13 +401,19 @@ bool ShellField::value(const PointSet &points, const Eigen::Vector3d &x, double 
     // One gather serves x and the six samples of its gradient.
     thread_local std::vector<uint32_t> near;
     gather(points, x, gradient ? kGradientStep : 0.0, near);
-    if (!value_among(points, near, x, f)) return false;
+    return value_among(points, near, x, f, gradient);
+}
+
+bool ShellField::value_among(const PointSet &points, const std::vector<uint32_t> &patches, const Eigen::Vector3d &x,
+                             double &f, Eigen::Vector3d *gradient) const {
+    if (!value_among(points, patches, x, f)) return false;
     if (gradient) {
         for (int d = 0; d < 3; ++d) {
             Eigen::Vector3d step = Eigen::Vector3d::Zero();
             step[d] = kGradientStep;
             double hi = 0.0, lo = 0.0;
-            const bool has_hi = value_among(points, near, x + step, hi), has_lo = value_among(points, near, x - step, lo);
+            const bool has_hi = value_among(points, patches, x + step, hi),
+                       has_lo = value_among(points, patches, x - step, lo);
             if (!has_hi) hi = f;
             if (!has_lo) lo = f;
             (*gradient)[d] = (hi - lo) / ((has_hi ? kGradientStep : 0.0) + (has_lo ? kGradientStep : 0.0) + 1e-300);

@@ -106,6 +106,14 @@ public:
     Eigen::Vector3d outward_normal(const PointSet &points, size_t i) const;
 
 private:
+    // value() from gather()'s patches for a ball that holds x and, with a gradient, the
+    // central-difference samples kGradientStep round it.
+    bool value_among(const PointSet &points, const std::vector<uint32_t> &patches, const Eigen::Vector3d &x,
+                     double &f, Eigen::Vector3d *gradient) const;
+    // Which sheet x lies on, as the two-sheet patches reaching it read it: the sum of their
+    // normals turned to x's side of each middle surface, weighted as in the blend (patches
+    // that put x within a fraction of a half gap of their middle abstain).
+    Eigen::Vector3d side_vote(const std::vector<uint32_t> &patches, const Eigen::Vector3d &x) const;
     // e(x): positive within the sampled sheets, negative past their rims; at a lattice node,
     // and interpolated between them.
     double rim_at_node(const PointSet &points, const Eigen::Vector3d &x) const;

@@ -57,6 +57,25 @@ double oriented_share(const std::vector<Vec3> &normals, const std::vector<Vec3> 
     return double(agree) / double(truth.size());
 }
 
+// A reconstruction of `count` points sampled on `truth`, checked against it: the mesh's
+// components and genus, the share of point normals facing the true side, and F at 0.5 % of
+// the diagonal (skipped without `score`).
+struct ShellRun {
+    MeshCheck check;
+    double oriented = 0.0, fscore = 0.0;
+};
+
+ShellRun reconstructed(const TriangleMesh &truth, size_t count, uint64_t seed, bool score = true) {
+    const MeshSamples samples = sample_mesh(truth, count, seed);
+    Reconstruction r = reconstruct(samples.positions);
+    assert_int_equal(r.status, GMPU_OK);
+    ShellRun run;
+    run.check = check_mesh(r.mesh);
+    run.oriented = oriented_share(r.normals, samples.normals);
+    if (score) run.fscore = compare_surfaces(r.mesh, truth, {30000, 1, {0.005, 0.01}, 0}).fscores[0].fscore;
+    return run;
+}
+
 gmpu::ShellField shell_reading(const std::vector<Vec3> &points) {
     std::vector<double> xyz;
     for (const Vec3 &p : points) xyz.insert(xyz.end(), {p.x(), p.y(), p.z()});
@@ -67,36 +86,25 @@ gmpu::ShellField shell_reading(const std::vector<Vec3> &points) {
 }
 
 void sparse_hollow_sphere_keeps_both_shells(void **) {
-    const TriangleMesh truth = hollow_sphere();
-    const MeshSamples samples = sample_mesh(truth, kSparse, 11);
-    Reconstruction r = reconstruct(samples.positions);
-    assert_int_equal(r.status, GMPU_OK);
-    const MeshCheck check = check_mesh(r.mesh);
-    const double oriented = oriented_share(r.normals, samples.normals);
-    const SurfaceComparison c = compare_surfaces(r.mesh, truth, {30000, 1, {0.005, 0.01}, 0});
-    print_message("hollow sphere: %zu components, oriented %.4f, F at 0.5 %% %.4f\n", check.components, oriented,
-                  c.fscores[0].fscore);
-    assert_true(check.watertight);
+    const ShellRun run = reconstructed(hollow_sphere(), kSparse, 11);
+    print_message("hollow sphere: %zu components, oriented %.4f, F at 0.5 %% %.4f\n", run.check.components,
+                  run.oriented, run.fscore);
+    assert_true(run.check.watertight);
     // One merged sheet: a single component with half the normals facing the wrong way.
-    assert_int_equal(check.components, 2);
-    assert_true(oriented > 0.97);
-    assert_true(c.fscores[0].fscore > 0.97);
+    assert_int_equal(run.check.components, 2);
+    assert_true(run.oriented > 0.97);
+    assert_true(run.fscore > 0.97);
 }
 
 void sparse_hollow_box_keeps_its_wall_round_edges_and_corners(void **) {
     // At the box's edges and corners no neighbourhood reads two sheets, and the faces'
     // patches meet there.
-    const TriangleMesh truth = hollow_box();
-    const MeshSamples samples = sample_mesh(truth, 2 * kSparse, 31);
-    Reconstruction r = reconstruct(samples.positions);
-    assert_int_equal(r.status, GMPU_OK);
-    const MeshCheck check = check_mesh(r.mesh);
-    const double oriented = oriented_share(r.normals, samples.normals);
-    const SurfaceComparison c = compare_surfaces(r.mesh, truth, {30000, 1, {0.005, 0.01}, 0});
+    const ShellRun run = reconstructed(hollow_box(), 2 * kSparse, 31);
+    const MeshCheck &check = run.check;
     print_message("hollow box: %zu components, genus %d and %d, oriented %.4f, F at 0.5 %% %.4f\n",
                   check.components, check.component_reports.empty() ? -1 : check.component_reports[0].genus,
-                  check.component_reports.size() < 2 ? -1 : check.component_reports[1].genus, oriented,
-                  c.fscores[0].fscore);
+                  check.component_reports.size() < 2 ? -1 : check.component_reports[1].genus, run.oriented,
+                  run.fscore);
     assert_true(check.watertight);
     // Each failure pierces the wall at the edges, joining the outer face to the inner one:
     // the misfit patches left out of the blend where the faces' patches reach (slots along
@@ -107,44 +115,34 @@ void sparse_hollow_box_keeps_its_wall_round_edges_and_corners(void **) {
     assert_int_equal(check.components, 2);
     assert_int_equal(check.component_reports[0].genus, 0);
     assert_int_equal(check.component_reports[1].genus, 0);
-    assert_true(oriented > 0.98);
+    assert_true(run.oriented > 0.98);
     // The misfits blended at full weight round the edges off (F at 0.5 % 0.04 lower).
-    assert_true(c.fscores[0].fscore > 0.88);
+    assert_true(run.fscore > 0.88);
 }
 
 void box_of_a_thousand_points_is_read_as_its_walls(void **) {
     // Half as many points: the wall is a quarter of a spacing thick and the faces' middles are
     // the only neighbourhoods clear of a fold, a quarter of them.
-    const TriangleMesh truth = hollow_box();
-    const MeshSamples samples = sample_mesh(truth, kSparse, 31);
-    Reconstruction r = reconstruct(samples.positions);
-    assert_int_equal(r.status, GMPU_OK);
-    const MeshCheck check = check_mesh(r.mesh);
-    const double oriented = oriented_share(r.normals, samples.normals);
-    const SurfaceComparison c = compare_surfaces(r.mesh, truth, {30000, 1, {0.005, 0.01}, 0});
-    print_message("hollow box, 1,000 points: %zu components, oriented %.4f, F at 0.5 %% %.4f\n", check.components,
-                  oriented, c.fscores[0].fscore);
-    assert_true(check.watertight);
+    const ShellRun run = reconstructed(hollow_box(), kSparse, 31);
+    print_message("hollow box, 1,000 points: %zu components, oriented %.4f, F at 0.5 %% %.4f\n",
+                  run.check.components, run.oriented, run.fscore);
+    assert_true(run.check.watertight);
     // Not read as a shell (the share of two-sheet neighbourhoods held to the thicker walls'
     // bar, or the noise estimate taking the folds for noise), the blend or the smooth
     // surface merges the two boxes into one with about half the normals inside out.
-    assert_int_equal(check.components, 2);
-    assert_true(oriented > 0.85);
-    assert_true(c.fscores[0].fscore > 0.75);
+    assert_int_equal(run.check.components, 2);
+    assert_true(run.oriented > 0.85);
+    assert_true(run.fscore > 0.75);
 }
 
 void points_near_a_fold_face_their_own_side(void **) {
     // Half the wall, 0.015: near the box's edges the blended middle surface bends, and points
     // on one sheet fall on the other's side of it; the two-sheet patches reaching them still
     // read their sheet.
-    const TriangleMesh truth = hollow_box(0.015);
-    const MeshSamples samples = sample_mesh(truth, kSparse, 37);
-    Reconstruction r = reconstruct(samples.positions);
-    assert_int_equal(r.status, GMPU_OK);
-    const double oriented = oriented_share(r.normals, samples.normals);
-    print_message("hollow box, wall 0.015, 1,000 points: %zu components, oriented %.4f\n",
-                  check_mesh(r.mesh).components, oriented);
-    assert_true(oriented > 0.93);
+    const ShellRun run = reconstructed(hollow_box(0.015), kSparse, 37, false);
+    print_message("hollow box, wall 0.015, 1,000 points: %zu components, oriented %.4f\n", run.check.components,
+                  run.oriented);
+    assert_true(run.oriented > 0.93);
 }
 
 void sparse_folded_wall_is_not_noise(void **) {
