@@ -32,9 +32,9 @@ void sign_leaves_by_normals(const Octree &tree, const PointSet &points, const fl
     }
 }
 
-// Inner cells follow their oriented children: the sign that makes the cell's gradient
-// agree with theirs at the children's points. Children come after parents, so a reverse
-// sweep sees every child oriented before its parent.
+}  // namespace
+
+// Children come after parents, so a reverse sweep sees every child oriented before its parent.
 void sign_inner_cells(const Octree &tree, const PointSet &points, CellSigns &signs, Progress &progress) {
     constexpr uint32_t kSamplesPerChild = 16;
     Eigen::Vector3d gp, gc;
@@ -60,7 +60,11 @@ void sign_inner_cells(const Octree &tree, const PointSet &points, CellSigns &sig
     }
 }
 
-}  // namespace
+uint32_t flipped_leaves(const Octree &tree, const CellSigns &signs) {
+    uint32_t count = 0;
+    for (size_t i = 0; i < tree.cells.size(); ++i) count += tree.cells[i].is_leaf() && signs[i] < 0;
+    return count;
+}
 
 Orientation orient_octree(const Octree &tree, const PointSet &points, const float *normals, Workers &workers,
                           Progress &progress, const FrontOptions &front) {
@@ -86,7 +90,7 @@ Orientation orient_octree(const Octree &tree, const PointSet &points, const floa
     }
     progress.throw_if_cancelled();
     sign_inner_cells(tree, points, signs, inner_progress);
-    for (size_t i = 0; i < tree.cells.size(); ++i) stats.flipped_leaves += tree.cells[i].is_leaf() && signs[i] < 0;
+    stats.flipped_leaves = flipped_leaves(tree, signs);
     return result;
 }
 

@@ -33,4 +33,11 @@ struct Orientation {
 Orientation orient_octree(const Octree &tree, const PointSet &points, const float *normals, Workers &workers,
                           Progress &progress, const FrontOptions &front = {});
 
+// Inner cells follow their oriented children: each takes the sign that makes its gradient
+// agree with theirs at the children's points. After any change to the leaves' signs.
+void sign_inner_cells(const Octree &tree, const PointSet &points, CellSigns &signs, Progress &progress);
+
+// How many leaves have their fit's sign turned (OrientStats::flipped_leaves).
+uint32_t flipped_leaves(const Octree &tree, const CellSigns &signs);
+
 }  // namespace gmpu

@@ -12,8 +12,10 @@
 #include "mesh/confidence.hpp"
 #include "mesh/grid_budget.hpp"
 #include "mesh/polygonizer.hpp"
+#include "orient/orient.hpp"
 #include "pipeline/blend_strays.hpp"
 #include "pipeline/free_sheet.hpp"
+#include "pipeline/inside_out_parts.hpp"
 #include "pipeline/smooth_normals.hpp"
 #include "pipeline/smooth_surface.hpp"
 
@@ -24,6 +26,12 @@ namespace {
 // Where the free-sheet test looks, in noise σ off each point: far enough to be off the noisy
 // sheet, near enough to stay within a thin part.
 constexpr double kFreeSheetOffset = 2.0;
+// Parts turned inside out as a whole are looked for below this many points: on denser clouds
+// the wrong normals left are patches on thin parts and in narrow gaps, not whole parts, and
+// the look would cost two winding numbers a point. Each round turns the parts found, then
+// looks again with the turned normals.
+constexpr size_t kInsideOutPartsBelowPoints = 20000;
+constexpr int kInsideOutRounds = 2;
 
 // The end of a successful stage, before it commits its result: the final report (fraction
 // 1), after which nothing slow follows; a cancel on it counts.
@@ -115,6 +123,18 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
     const bool noisy_fits = noise >= 0.25 * epsilon;
     measures = measure_points(mpu, points, pool, measures_progress, noisy_fits);
     winding = WindingField(tree, points, measures.blend_normals, measures.area, &winding_progress);
+    // A sparse solid's parts turned inside out as a whole (inside_out_parts.hpp). Not a thin
+    // shell's: beside its wall the winding number is 0 whichever way a sheet faces.
+    if (input_normals.empty() && !thin_shell && points.size() < kInsideOutPartsBelowPoints)
+        for (int round = 0; round < kInsideOutRounds; ++round) {
+            Progress part_progress = winding_progress.slice(1.0, 1.0);
+            if (turn_inside_out_parts(tree, points, measures, winding, orientation.signs, pool, part_progress) == 0)
+                break;
+            sign_inner_cells(tree, points, orientation.signs, part_progress);
+            measures = measure_points(mpu, points, pool, part_progress, noisy_fits);
+            winding = WindingField(tree, points, measures.blend_normals, measures.area, &part_progress);
+            orientation.stats.flipped_leaves = flipped_leaves(tree, orientation.signs);
+        }
     // The test's mesh is the one polygonize would make of the blend: at its grid and level.
     const int resolution = params.resolution > 0 ? params.resolution : blend_resolution();
     double seconds = 0.0;
