@@ -24,9 +24,6 @@ constexpr size_t kNeighbours = 8;
 // centre (it adds as much behind as it takes in front): neither passes.
 constexpr double kMinGain = 0.3;
 constexpr double kTurnedBand = 0.2;
-// Parts larger than this share of the cloud are left alone: a part that large is the bulk of
-// the cloud, not a limb (and the outward pass has decided the bulk's side).
-constexpr double kMaxPartShare = 0.5;
 // A part is judged at no more than this many of its points.
 constexpr size_t kMaxJudged = 1024;
 
@@ -76,7 +73,6 @@ size_t turn_inside_out_parts(const Octree &tree, const PointSet &points, const P
     // a point's behind and ahead swap, so its centre moves only by what the part adds there.
     std::vector<uint8_t> turn(n, 0), seen(n, 0);
     std::vector<uint32_t> part, stack;
-    const size_t max_part = size_t(kMaxPartShare * double(n));
     for (size_t s = 0; s < n; ++s) {
         progress.poll(0.8 + 0.2 * double(s) / double(n));
         if (seen[s] || !(centre[s] < kSeedCentre)) continue;
@@ -97,7 +93,6 @@ size_t turn_inside_out_parts(const Octree &tree, const PointSet &points, const P
                 stack.push_back(j);
             }
         }
-        if (part.size() > max_part) continue;
         // Judged at up to kMaxJudged of its points, evenly strided: every point of the part
         // adds its dipole at each, so a large part costs kMaxJudged × its size, not its square.
         const size_t stride = std::max<size_t>(1, part.size() / kMaxJudged);
