@@ -28,12 +28,9 @@ namespace {
 constexpr double kFreeSheetOffset = 2.0;
 // Parts turned inside out as a whole are looked for below this many points: on denser clouds
 // the wrong normals left are patches on thin parts and in narrow gaps, not whole parts, and
-// the look would cost two winding numbers a point. Nor under kInsideOutPartsFromPoints: a
-// cloud of a few hundred points has no limb of more than a handful, and turning leaves there
-// can leave no surface near the points. Each round turns the parts found, then looks again
-// with the turned normals.
+// the look would cost two winding numbers a point. Each round turns the parts found, then
+// looks again with the turned normals.
 constexpr size_t kInsideOutPartsBelowPoints = 20000;
-constexpr size_t kInsideOutPartsFromPoints = 500;
 constexpr int kInsideOutRounds = 2;
 
 // The end of a successful stage, before it commits its result: the final report (fraction
@@ -128,8 +125,7 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
     winding = WindingField(tree, points, measures.blend_normals, measures.area, &winding_progress);
     // A sparse solid's parts turned inside out as a whole (inside_out_parts.hpp). Not a thin
     // shell's: beside its wall the winding number is 0 whichever way a sheet faces.
-    if (input_normals.empty() && !thin_shell && points.size() >= kInsideOutPartsFromPoints &&
-        points.size() < kInsideOutPartsBelowPoints)
+    if (input_normals.empty() && !thin_shell && points.size() < kInsideOutPartsBelowPoints)
         for (int round = 0; round < kInsideOutRounds; ++round) {
             Progress part_progress = winding_progress.slice(1.0, 1.0);
             if (turn_inside_out_parts(tree, points, measures, winding, orientation.signs, pool, part_progress) == 0)
