@@ -77,11 +77,7 @@ double WindingField::visit(uint32_t index, const Eigen::Vector3d &q, double far_
         return kInv4Pi * m.dipole.dot(r) / (d2 * std::sqrt(d2));
     if (c.is_leaf()) {
         double w = 0.0;
-        for (uint32_t k = c.point_begin; k < c.point_end; ++k) {
-            Eigen::Vector3d rp = points_->point(tree_->order[k]) - q;
-            double e2 = rp.squaredNorm();
-            if (e2 > 1e-24) w += kInv4Pi * weighted(tree_->order[k]).dot(rp) / (e2 * std::sqrt(e2));
-        }
+        for (uint32_t k = c.point_begin; k < c.point_end; ++k) w += point_winding(tree_->order[k], q);
         return w;
     }
     double w = 0.0;
@@ -90,6 +86,12 @@ double WindingField::visit(uint32_t index, const Eigen::Vector3d &q, double far_
         if (k >= 0) w += visit(uint32_t(k), q, far_ratio2);
     }
     return w;
+}
+
+double WindingField::point_winding(uint32_t i, const Eigen::Vector3d &q) const {
+    const Eigen::Vector3d rp = points_->point(i) - q;
+    const double e2 = rp.squaredNorm();
+    return e2 > 1e-24 ? kInv4Pi * weighted(i).dot(rp) / (e2 * std::sqrt(e2)) : 0.0;
 }
 
 double WindingField::winding(const Eigen::Vector3d &q, double far_ratio) const {

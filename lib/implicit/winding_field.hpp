@@ -29,6 +29,8 @@ public:
     // smaller ratio is cheaper and coarser (enough to tell 0 from 1 well away from the data).
     double winding(const Eigen::Vector3d &q, double far_ratio = 2.0) const;
     bool empty() const { return moments_.empty(); }
+    // What point i adds to the winding number at q, as the near leaves sum it.
+    double point_winding(uint32_t i, const Eigen::Vector3d &q) const;
     // The radius of cell `cell`'s points about their area-weighted centroid (0 for a cell
     // without area): what decides when the cell counts as one dipole.
     double radius(uint32_t cell) const { return moments_[cell].radius; }

@@ -31,14 +31,6 @@ Eigen::Vector3d normal_of(const std::vector<float> &normals, size_t i) {
     return Eigen::Vector3d(normals[3 * i], normals[3 * i + 1], normals[3 * i + 2]);
 }
 
-// The winding number point i adds at q, as the field sums it near its leaves.
-double dipole(const PointSet &points, const PointMeasures &measures, uint32_t i, const Eigen::Vector3d &q) {
-    const Eigen::Vector3d d = points.point(i) - q;
-    const double r = d.norm();
-    if (!(r > 0.0)) return 0.0;
-    return double(measures.area[i]) * d.dot(normal_of(measures.blend_normals, i)) / (4.0 * M_PI * r * r * r);
-}
-
 // A spacing at point i: its k-th neighbour distance over √k, from the area it stands for.
 double spacing(const PointMeasures &measures, size_t i) { return std::sqrt(double(measures.area[i]) / M_PI); }
 
@@ -48,7 +40,7 @@ size_t turn_inside_out_parts(const Octree &tree, const PointSet &points, const P
                              const WindingField &winding, CellSigns &signs, Workers &workers, Progress &progress) {
     const size_t n = points.size();
     if (n == 0 || winding.empty() || measures.blend_normals.size() != 3 * n || measures.area.size() != n) return 0;
-    Progress centre_progress = progress.slice(0.0, 0.6), graph_progress = progress.slice(0.6, 0.8);
+    Progress centre_progress = progress.slice(0.0, 0.8);
 
     // Each point's centre: the mean winding number a spacing behind and in front of it.
     std::vector<Eigen::Vector3d> behind(n), ahead(n);
@@ -59,20 +51,11 @@ size_t turn_inside_out_parts(const Octree &tree, const PointSet &points, const P
         ahead[i] = points.point(i) + step;
         centre[i] = 0.5 * (winding.winding(behind[i]) + winding.winding(ahead[i]));
     });
-    std::vector<uint32_t> neighbours(n * kNeighbours, UINT32_MAX);
-    parallel_for(0, n, workers, graph_progress, [&](size_t i) {
-        thread_local std::vector<uint32_t> near;
-        thread_local std::vector<float> d2;
-        points.nearest(points.point(i), kNeighbours + 1, near, d2);
-        size_t m = 0;
-        for (uint32_t j : near)
-            if (j != i && m < kNeighbours) neighbours[i * kNeighbours + m++] = j;
-    });
-
     // Grow the parts from their seeds, then judge each with its own dipoles reversed: turned,
     // a point's behind and ahead swap, so its centre moves only by what the part adds there.
     std::vector<uint8_t> turn(n, 0), seen(n, 0);
-    std::vector<uint32_t> part, stack;
+    std::vector<uint32_t> part, stack, near;
+    std::vector<float> d2;
     for (size_t s = 0; s < n; ++s) {
         progress.poll(0.8 + 0.2 * double(s) / double(n));
         if (seen[s] || !(centre[s] < kSeedCentre)) continue;
@@ -83,10 +66,10 @@ size_t turn_inside_out_parts(const Octree &tree, const PointSet &points, const P
             const uint32_t i = stack.back();
             stack.pop_back();
             const Eigen::Vector3d ni = normal_of(measures.blend_normals, i);
-            for (size_t m = 0; m < kNeighbours; ++m) {
-                const uint32_t j = neighbours[i * kNeighbours + m];
-                if (j == UINT32_MAX || seen[j] || !(centre[j] < kGrowCentre) ||
-                    !(ni.dot(normal_of(measures.blend_normals, j)) > 0.0))
+            // Only the parts' points ask for their neighbours: most clouds have few or none.
+            points.nearest(points.point(i), kNeighbours + 1, near, d2);
+            for (uint32_t j : near) {
+                if (seen[j] || !(centre[j] < kGrowCentre) || !(ni.dot(normal_of(measures.blend_normals, j)) > 0.0))
                     continue;
                 seen[j] = 1;
                 part.push_back(j);
@@ -102,7 +85,7 @@ size_t turn_inside_out_parts(const Octree &tree, const PointSet &points, const P
             progress.tick();
             const uint32_t i = part[k];
             double own = 0.0;
-            for (uint32_t j : part) own += dipole(points, measures, j, behind[i]) + dipole(points, measures, j, ahead[i]);
+            for (uint32_t j : part) own += winding.point_winding(j, behind[i]) + winding.point_winding(j, ahead[i]);
             before += centre[i];
             after += centre[i] - own;  // ½ (w − 2·own) at both
         }
@@ -115,8 +98,6 @@ size_t turn_inside_out_parts(const Octree &tree, const PointSet &points, const P
 
     // A leaf turns with the majority of its points (a leaf holding none, with its nearest).
     size_t turned = 0;
-    std::vector<uint32_t> near;
-    std::vector<float> d2;
     for (size_t c = 0; c < tree.cells.size(); ++c) {
         const Cell &cell = tree.cells[c];
         if (!cell.is_leaf()) continue;

@@ -121,8 +121,12 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
     const MpuFunction mpu(tree, orientation.signs, 0);
     // Noise-limited fits: the noise estimate is a sizeable share of the ε the tree was fitted to.
     const bool noisy_fits = noise >= 0.25 * epsilon;
-    measures = measure_points(mpu, points, pool, measures_progress, noisy_fits);
-    winding = WindingField(tree, points, measures.blend_normals, measures.area, &winding_progress);
+    // The point measures of the blend as signed now, and the winding field of its normals.
+    auto measure = [&](Progress &measure_progress, Progress &wind_progress) {
+        measures = measure_points(mpu, points, pool, measure_progress, noisy_fits);
+        winding = WindingField(tree, points, measures.blend_normals, measures.area, &wind_progress);
+    };
+    measure(measures_progress, winding_progress);
     // A sparse solid's parts turned inside out as a whole (inside_out_parts.hpp). Not a thin
     // shell's: beside its wall the winding number is 0 whichever way a sheet faces.
     if (input_normals.empty() && !thin_shell && points.size() < kInsideOutPartsBelowPoints)
@@ -131,8 +135,7 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
             if (turn_inside_out_parts(tree, points, measures, winding, orientation.signs, pool, part_progress) == 0)
                 break;
             sign_inner_cells(tree, points, orientation.signs, part_progress);
-            measures = measure_points(mpu, points, pool, part_progress, noisy_fits);
-            winding = WindingField(tree, points, measures.blend_normals, measures.area, &part_progress);
+            measure(part_progress, part_progress);
             orientation.stats.flipped_leaves = flipped_leaves(tree, orientation.signs);
         }
     // The test's mesh is the one polygonize would make of the blend: at its grid and level.
