@@ -348,6 +348,9 @@ static int write_outputs(gmpu_mesh **mesh, gmpu_surface **surface, const gmpu_po
          * million points, the two together would set the peak). */
         gmpu_surface_destroy(*surface);
         *surface = NULL;
+        /* The surface's pages back to the system before the copy: kept in the heap, the copy
+         * would stack on them and set the run's peak. */
+        release_free_memory();
         ok = ok && gmpu_points_create(gmpu_points_positions(cloud), normals, n, &oriented) == GMPU_OK;
         free(normals);
         const int written = ok && gmpu_points_write(oriented, points_out->staging) == GMPU_OK;
