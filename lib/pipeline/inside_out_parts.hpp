@@ -5,6 +5,9 @@
 // oriented points does. Just beside a correctly oriented point it averages ½ (1 behind, 0
 // in front); around a part turned inside out it averages −½ (−1 inside, 0 outside), and
 // around a part whose sides disagree, about 0.
+// An inner part turned inside out (a spool's core between its flanges) can read about 0
+// too; there open space tells: from just in front of a point, rays along its outward normal
+// mostly escape the cloud, along the inward one they meet the far side (geometry/open_sky.hpp).
 #pragma once
 
 #include <cstddef>
@@ -26,5 +29,13 @@ namespace gmpu {
 // many leaves were turned; 0 leaves `signs` as they were.
 size_t turn_inside_out_parts(const Octree &tree, const PointSet &points, const PointMeasures &measures,
                              const WindingField &winding, CellSigns &signs, Workers &workers, Progress &progress);
+
+// Finds the parts whose points' normals face away from open space (their rays escape clearly
+// more often behind than in front), and turns the leaves of each part of at least a few
+// points whose winding centres agree that it does not face out (their median well under ½:
+// between close blades or in a narrow slot both sides are shut in, but the centres of
+// points facing out sit near ½). Same contract as turn_inside_out_parts.
+size_t turn_parts_facing_in(const Octree &tree, const PointSet &points, const PointMeasures &measures,
+                            const WindingField &winding, CellSigns &signs, Workers &workers, Progress &progress);
 
 }  // namespace gmpu

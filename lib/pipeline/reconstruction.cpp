@@ -129,15 +129,23 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
     measure(measures_progress, winding_progress);
     // A sparse solid's parts turned inside out as a whole (inside_out_parts.hpp). Not a thin
     // shell's: beside its wall the winding number is 0 whichever way a sheet faces.
-    if (input_normals.empty() && !thin_shell && points.size() < kInsideOutPartsBelowPoints)
-        for (int round = 0; round < kInsideOutRounds; ++round) {
-            Progress part_progress = winding_progress.slice(1.0, 1.0);
-            if (turn_inside_out_parts(tree, points, measures, winding, orientation.signs, pool, part_progress) == 0)
-                break;
+    // Then the parts facing away from open space that the winding number does not see as
+    // facing out (an inner part, whose centres read about 0).
+    if (input_normals.empty() && !thin_shell && points.size() < kInsideOutPartsBelowPoints) {
+        Progress part_progress = winding_progress.slice(1.0, 1.0);
+        auto remeasure = [&] {
             sign_inner_cells(tree, points, orientation.signs, part_progress);
             measure(part_progress, part_progress);
             orientation.stats.flipped_leaves = flipped_leaves(tree, orientation.signs);
+        };
+        for (int round = 0; round < kInsideOutRounds; ++round) {
+            if (turn_inside_out_parts(tree, points, measures, winding, orientation.signs, pool, part_progress) == 0)
+                break;
+            remeasure();
         }
+        if (turn_parts_facing_in(tree, points, measures, winding, orientation.signs, pool, part_progress) > 0)
+            remeasure();
+    }
     // The test's mesh is the one polygonize would make of the blend: at its grid and level.
     const int resolution = params.resolution > 0 ? params.resolution : blend_resolution();
     double seconds = 0.0;

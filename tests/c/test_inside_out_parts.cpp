@@ -3,6 +3,8 @@
 // limb is turned back and the body is not touched; with the body's, the body is turned back. Through the whole pipeline, a 1,000-point
 // hub's blades that the front turned inside out are turned back, and blades thinner than a
 // spacing, beside which the winding number cannot tell, are left as orientation made them.
+// Open space: a spool whose core's leaves are turned by hand, which the winding number does
+// not see, is turned back, as is the limb.
 #include <algorithm>
 #include <cmath>
 #include <random>
@@ -66,9 +68,47 @@ Samples body_with_limb() {
     return s;
 }
 
+// A spool: a core of radius 0.4 along z from −0.6 to 0.6 between two flanges of radius 1,
+// 0.1 thick. Uniform random samples of the union's surface, 200 per unit area (about 3,200
+// in all: leaves small enough that those on the core hold no flange points); `on_limb`
+// marks the core's.
+Samples spool(unsigned seed) {
+    constexpr double kCore = 0.4, kHalf = 0.6, kFlange = 1.0, kThick = 0.1, kDensity = 200.0;
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> unit(0.0, 1.0);
+    Samples s;
+    auto add = [&](const Vector3d &p, const Vector3d &n, bool core) {
+        s.xyz.insert(s.xyz.end(), {p[0], p[1], p[2]});
+        s.outward.push_back(n);
+        s.on_limb.push_back(core);
+    };
+    auto count = [&](double area) { return size_t(kDensity * area); };
+    // Lateral surfaces: the core's, and each flange's rim.
+    auto side = [&](double r, double z0, double z1, bool core) {
+        for (size_t i = 0, n = count(2 * M_PI * r * (z1 - z0)); i < n; ++i) {
+            const double a = 2 * M_PI * unit(rng), z = z0 + (z1 - z0) * unit(rng);
+            add(Vector3d(r * std::cos(a), r * std::sin(a), z), Vector3d(std::cos(a), std::sin(a), 0), core);
+        }
+    };
+    // Flat annuli between radii r0 and r1 at height z, facing `up` (±1).
+    auto annulus = [&](double r0, double r1, double z, double up) {
+        for (size_t i = 0, n = count(M_PI * (r1 * r1 - r0 * r0)); i < n; ++i) {
+            const double a = 2 * M_PI * unit(rng), r = std::sqrt(r0 * r0 + (r1 * r1 - r0 * r0) * unit(rng));
+            add(Vector3d(r * std::cos(a), r * std::sin(a), z), Vector3d(0, 0, up), false);
+        }
+    };
+    side(kCore, -kHalf, kHalf, true);
+    for (double up : {-1.0, 1.0}) {
+        side(kFlange, up > 0 ? kHalf : -kHalf - kThick, up > 0 ? kHalf + kThick : -kHalf, false);
+        annulus(0.0, kFlange, up * (kHalf + kThick), up);
+        annulus(kCore, kFlange, up * kHalf, -up);
+    }
+    return s;
+}
+
 struct Fixture {
-    Samples samples = body_with_limb();
-    PointSet points = PointSet::from_array(samples.xyz.data(), samples.outward.size(), 0, 15);
+    Samples samples;
+    PointSet points;
     Workers workers{2};
     Progress quiet{nullptr, nullptr, GMPU_STAGE_ORIENT};
     Octree tree;
@@ -76,7 +116,8 @@ struct Fixture {
     PointMeasures measures;
     WindingField winding;
 
-    Fixture() {
+    explicit Fixture(Samples s = body_with_limb())
+        : samples(std::move(s)), points(PointSet::from_array(samples.xyz.data(), samples.outward.size(), 0, 15)) {
         Params params;
         tree = build_octree(points, params, effective_epsilon(points, params, 0.0), workers, quiet);
         signs = orient_octree(tree, points, nullptr, workers, quiet).signs;
@@ -112,6 +153,7 @@ struct Fixture {
         return turned;
     }
     size_t repair() { return turn_inside_out_parts(tree, points, measures, winding, signs, workers, quiet); }
+    size_t repair_facing_in() { return turn_parts_facing_in(tree, points, measures, winding, signs, workers, quiet); }
 };
 
 void a_body_and_its_limb_facing_out_are_left_alone(void **) {
@@ -149,6 +191,44 @@ void a_limb_turned_inside_out_is_turned_back(void **) {
         ++body_leaves;
     }
     assert_true(body_leaves > 100);
+}
+
+void a_spool_whose_core_was_turned_inside_out_is_turned_back_by_open_space(void **) {
+    // Turned by hand, the core between the flanges reads winding centres about 0, not −½:
+    // the winding number's look leaves it. Its rays, shut in by the flanges towards the axis,
+    // escape along its true outward normal: the open-space look turns it back.
+    Fixture f(spool(3));
+    print_message("spool: core %.3f, flanges %.3f facing out\n", f.facing_out(true), f.facing_out(false));
+    assert_true(f.facing_out(true) > 0.97);
+    assert_true(f.facing_out(false) > 0.97);
+    assert_int_equal(f.repair_facing_in(), 0);
+    f.turn_leaves([&](uint32_t i) { return bool(f.samples.on_limb[i]); });
+    f.measure();
+    assert_true(f.facing_out(true) < 0.2);
+    const size_t by_winding = f.repair();
+    if (by_winding > 0) f.measure();
+    print_message("core turned by hand: %.3f facing out after the winding look (%zu leaves)\n", f.facing_out(true),
+                  by_winding);
+    assert_true(f.facing_out(true) < 0.5);
+    assert_true(f.repair_facing_in() > 0);
+    f.measure();
+    print_message("turned back by open space: core %.3f, flanges %.3f facing out\n", f.facing_out(true),
+                  f.facing_out(false));
+    assert_true(f.facing_out(true) > 0.9);
+    assert_true(f.facing_out(false) > 0.97);
+}
+
+void a_limb_turned_inside_out_is_turned_back_by_open_space(void **) {
+    Fixture f;
+    assert_int_equal(f.repair_facing_in(), 0);
+    f.turn_leaves([&](uint32_t i) { return bool(f.samples.on_limb[i]); });
+    f.measure();
+    assert_true(f.repair_facing_in() > 0);
+    f.measure();
+    print_message("limb turned back by open space: limb %.3f, body %.3f facing out\n", f.facing_out(true),
+                  f.facing_out(false));
+    assert_true(f.facing_out(true) > 0.97);
+    assert_true(f.facing_out(false) > 0.99);
 }
 
 void a_body_turned_inside_out_beside_its_limb_is_turned_back(void **) {
@@ -248,6 +328,8 @@ int main() {
         cmocka_unit_test(a_body_and_its_limb_facing_out_are_left_alone),
         cmocka_unit_test(a_limb_turned_inside_out_is_turned_back),
         cmocka_unit_test(a_body_turned_inside_out_beside_its_limb_is_turned_back),
+        cmocka_unit_test(a_spool_whose_core_was_turned_inside_out_is_turned_back_by_open_space),
+        cmocka_unit_test(a_limb_turned_inside_out_is_turned_back_by_open_space),
         cmocka_unit_test(blades_turned_inside_out_are_turned_back),
         cmocka_unit_test(thin_blades_whose_sides_disagree_are_left),
     };
