@@ -152,6 +152,12 @@ struct Fixture {
         }
         return turned;
     }
+    // Turns the leaves of the marked part (the limb, the core) by hand and measures again.
+    size_t turn_part_by_hand() {
+        const size_t turned = turn_leaves([&](uint32_t i) { return bool(samples.on_limb[i]); });
+        measure();
+        return turned;
+    }
     size_t repair() { return turn_inside_out_parts(tree, points, measures, winding, signs, workers, quiet); }
     size_t repair_facing_in() { return turn_parts_facing_in(tree, points, measures, winding, signs, workers, quiet); }
 };
@@ -166,8 +172,7 @@ void a_body_and_its_limb_facing_out_are_left_alone(void **) {
 void a_limb_turned_inside_out_is_turned_back(void **) {
     Fixture f;
     const CellSigns oriented = f.signs;
-    const size_t turned_by_hand = f.turn_leaves([&](uint32_t i) { return bool(f.samples.on_limb[i]); });
-    f.measure();
+    const size_t turned_by_hand = f.turn_part_by_hand();
     print_message("limb turned by hand: %zu leaves, %.3f of its points facing out\n", turned_by_hand,
                   f.facing_out(true));
     assert_true(turned_by_hand > 20);
@@ -202,8 +207,7 @@ void a_spool_whose_core_was_turned_inside_out_is_turned_back_by_open_space(void 
     assert_true(f.facing_out(true) > 0.97);
     assert_true(f.facing_out(false) > 0.97);
     assert_int_equal(f.repair_facing_in(), 0);
-    f.turn_leaves([&](uint32_t i) { return bool(f.samples.on_limb[i]); });
-    f.measure();
+    f.turn_part_by_hand();
     assert_true(f.facing_out(true) < 0.2);
     const size_t by_winding = f.repair();
     if (by_winding > 0) f.measure();
@@ -221,8 +225,7 @@ void a_spool_whose_core_was_turned_inside_out_is_turned_back_by_open_space(void 
 void a_limb_turned_inside_out_is_turned_back_by_open_space(void **) {
     Fixture f;
     assert_int_equal(f.repair_facing_in(), 0);
-    f.turn_leaves([&](uint32_t i) { return bool(f.samples.on_limb[i]); });
-    f.measure();
+    f.turn_part_by_hand();
     assert_true(f.repair_facing_in() > 0);
     f.measure();
     print_message("limb turned back by open space: limb %.3f, body %.3f facing out\n", f.facing_out(true),
