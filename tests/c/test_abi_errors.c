@@ -728,6 +728,8 @@ static void test_reentrant_calls_refused(void **state) {
                                                "gmpu_surface_polygonize"};
     for (int during = GMPU_STAGE_FIT; during <= GMPU_STAGE_POLYGONIZE; ++during)
         for (int what = 0; what < RE_COUNT; ++what) {
+            /* Under valgrind each call is tried during one stage only, each stage in turn. */
+            if (robust_quick() && what % 3 != during - GMPU_STAGE_FIT) continue;
             struct reentry_probe p = {NULL, (enum reentry)what, (gmpu_stage)during, 0, GMPU_OK, ""};
             gmpu_surface *s = new_surface();
             p.s = s;

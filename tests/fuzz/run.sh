@@ -14,13 +14,12 @@ set -euo pipefail
 seconds=${1:?usage: tests/fuzz/run.sh SECONDS [TARGET...]}
 shift
 root=$(cd "$(dirname "${BASH_SOURCE[0]}")/../.." && pwd)
-# `make fuzz` / `make fuzz-quick` use the sanitizer build (GMPU_FUZZ_BUILD=build-sanitize).
 build=$(cd "$root" && mkdir -p "${GMPU_FUZZ_BUILD:-build-fuzz}" && cd "${GMPU_FUZZ_BUILD:-build-fuzz}" && pwd)
 targets=(ply xyz off obj pipeline)
 [ $# -gt 0 ] && targets=("$@")
 
 if [ ! -f "$build/build.ninja" ]; then
-  # The same configuration as the Makefile's build-sanitize (keep them in step).
+  # The Makefile's build-sanitize configuration, with libFuzzer's coverage instrumentation.
   CC=clang CXX=clang++ meson setup "$build" "$root" -Dfuzz=true -Dtests=false \
     -Db_lundef=false -Db_sanitize=address,undefined -Doptimization=2 -Ddebug=true \
     -Dcpp_args='-fsanitize=fuzzer-no-link -fno-sanitize-recover=all' -Dc_args=-fno-sanitize-recover=all >/dev/null
