@@ -64,9 +64,10 @@ double winding_centre(const PointSet &points, const PointMeasures &measures, con
 }
 
 // Grows the part of `seed` (not yet seen) over the nearest neighbours of like normal whose
-// score is under `grow`, marking them seen.
-void grow_part(const PointSet &points, const std::vector<float> &normals, const std::vector<double> &score,
-               uint32_t seed, double grow, std::vector<uint8_t> &seen, std::vector<uint32_t> &part) {
+// score(j) is under `grow`, marking them seen.
+template <class Score>
+void grow_part(const PointSet &points, const std::vector<float> &normals, const Score &score, uint32_t seed,
+               double grow, std::vector<uint8_t> &seen, std::vector<uint32_t> &part) {
     thread_local std::vector<uint32_t> stack, near;
     thread_local std::vector<float> d2;
     part.assign(1, seed);
@@ -79,7 +80,7 @@ void grow_part(const PointSet &points, const std::vector<float> &normals, const 
         // Only the parts' points ask for their neighbours: most clouds have few parts or none.
         points.nearest(points.point(i), kNeighbours + 1, near, d2);
         for (uint32_t j : near) {
-            if (seen[j] || !(score[j] < grow) || !(ni.dot(normal_of(normals, j)) > 0.0)) continue;
+            if (seen[j] || !(ni.dot(normal_of(normals, j)) > 0.0) || !(score(j) < grow)) continue;
             seen[j] = 1;
             part.push_back(j);
             stack.push_back(j);
@@ -131,7 +132,8 @@ size_t turn_inside_out_parts(const Octree &tree, const PointSet &points, const P
     for (size_t s = 0; s < n; ++s) {
         progress.poll(0.8 + 0.2 * double(s) / double(n));
         if (seen[s] || !(centre[s] < kSeedCentre)) continue;
-        grow_part(points, measures.blend_normals, centre, uint32_t(s), kGrowCentre, seen, part);
+        grow_part(points, measures.blend_normals, [&](uint32_t j) { return centre[j]; }, uint32_t(s), kGrowCentre,
+                  seen, part);
         // Judged at up to kMaxJudged of its points, evenly strided: every point of the part
         // adds its dipole at each, so a large part costs kMaxJudged × its size, not its square.
         const size_t stride = std::max<size_t>(1, part.size() / kMaxJudged);
@@ -165,20 +167,33 @@ size_t turn_parts_facing_in(const Octree &tree, const PointSet &points, const Po
     if (!(typical > 0.0)) return 0;
     const OpenSky sky(points, kBlockSpacings * typical);
     // Openness: the share of rays that escape in front less the share behind, in [−1, 1].
-    Progress open_progress = progress.slice(0.0, 0.9);
-    std::vector<double> openness(n);
-    parallel_for(0, n, workers, open_progress, [&](size_t i) {
-        const Eigen::Vector3d normal = normal_of(measures.blend_normals, i), p = points.point(i);
-        const Eigen::Vector3d step = kStartSpacings * typical * normal;
-        openness[i] = sky.escaping(p + step, normal) - sky.escaping(p - step, -normal);
+    // The rays in front are cast at every point; those behind (which cross the solid, the
+    // longer walk) only where a seed or a part's growth asks for the openness: a point whose
+    // front alone keeps it above kSeedOpenness (front − 1 ≥ it) cannot seed.
+    // (A Vector3d: an Eigen expression would outlive the normal it refers to.)
+    auto start = [&](size_t i) -> Eigen::Vector3d {
+        return kStartSpacings * typical * normal_of(measures.blend_normals, i);
+    };
+    Progress front_progress = progress.slice(0.0, 0.9);
+    std::vector<double> front(n), openness(n);
+    std::vector<uint8_t> cast(n, 0);
+    parallel_for(0, n, workers, front_progress, [&](size_t i) {
+        front[i] = sky.escaping(points.point(i) + start(i), normal_of(measures.blend_normals, i));
     });
+    auto open = [&](uint32_t i) {
+        if (!cast[i]) {
+            openness[i] = front[i] - sky.escaping(points.point(i) - start(i), -normal_of(measures.blend_normals, i));
+            cast[i] = 1;
+        }
+        return openness[i];
+    };
     std::vector<uint8_t> turn(n, 0), seen(n, 0);
     std::vector<uint32_t> part;
     std::vector<double> centres;
     for (size_t s = 0; s < n; ++s) {
         progress.poll(0.9 + 0.1 * double(s) / double(n));
-        if (seen[s] || !(openness[s] < kSeedOpenness)) continue;
-        grow_part(points, measures.blend_normals, openness, uint32_t(s), kGrowOpenness, seen, part);
+        if (seen[s] || !(front[s] - 1.0 < kSeedOpenness) || !(open(uint32_t(s)) < kSeedOpenness)) continue;
+        grow_part(points, measures.blend_normals, open, uint32_t(s), kGrowOpenness, seen, part);
         if (part.size() < kMinPart) continue;
         double mean = 0.0;
         for (uint32_t i : part) mean += openness[i];
