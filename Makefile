@@ -184,10 +184,12 @@ test-sanitize: deps-test $(SAN_BUILD)/build.ninja
 	$(SAN_ENV) $(PYTHON) tests/cli/hostile_corpus.py run $(SAN_BUILD)/examples/gmpu-reconstruct $(SAN_BUILD)/hostile
 
 # ThreadSanitizer: concurrent evaluate from 8 threads on one surface, separate surfaces in
-# separate threads (tests/c/test_concurrency.c), against a TSan build of the library.
+# separate threads (tests/c/test_concurrency.c), against a TSan build of the library. That
+# build leaves the precompiled header out (b_pch=false), so every source is also compiled
+# with only the includes it names (lib/pch/gmpu_pch.hpp).
 test-tsan: deps-test
 	@[ -f $(TSAN_BUILD)/build.ninja ] || meson setup $(TSAN_BUILD) -Db_sanitize=thread -Db_lundef=false \
-	  -Dtests=false -Doptimization=2 -Ddebug=true
+	  -Dtests=false -Doptimization=2 -Ddebug=true -Db_pch=false
 	ninja -C $(TSAN_BUILD) lib/libgmpu.so.1.0.0
 	cc -std=c11 -O1 -g -fsanitize=thread -Iinclude tests/c/test_concurrency.c tests/c/abort_on_failure.c \
 	  -o $(TSAN_BUILD)/test_concurrency -L$(TSAN_BUILD)/lib -lgmpu -lcmocka -lm -pthread \

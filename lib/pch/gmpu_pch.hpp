@@ -1,8 +1,9 @@
 // The headers most of the library's sources include, precompiled once for all of them
 // (meson's cpp_pch in lib/meson.build): Eigen's are the bulk of each source's parse. The
-// library is compiled several times over in `make test` (release, sanitizers, ThreadSanitizer,
-// fuzzing, the Python wheels, a meson subproject). Every source still includes what it uses,
-// so a build with -Db_pch=false compiles the same.
+// library is compiled several times over in `make test` (release, sanitizers,
+// fuzzing, the Python wheels, a meson subproject). Every source still includes what it uses:
+// `make test-tsan` builds the library with -Db_pch=false, which fails on a source that
+// leans on this header.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
