@@ -846,6 +846,10 @@ void parallel_for_rethrows_and_cancels(void **) {
         parallel_for(0, 100000, workers, progress, [&](size_t i) {
             ++ran;
             if (i == 50) throw Error(GMPU_ERROR_INTERNAL, "boom");
+            // Every other index takes a little while: bodies that cost nothing let the other
+            // thread run out the range while the throwing one unwinds (slow under the
+            // sanitizers) or waits for a core on a busy machine, and it would not stop early.
+            std::this_thread::sleep_for(std::chrono::microseconds(20));
         }, 1);
     });
     assert_int_equal(s, GMPU_ERROR_INTERNAL);
