@@ -244,9 +244,9 @@ bench-corpus: deps-bench build
 	$(PYTHON) tests/bench/run_bench.py --corpus-only --corpus-peers $(CORPUS_PEERS) --build $(BUILD) --out bench-results
 	$(PYTHON) tests/bench/update_readme.py bench-results --sections corpus
 
-# The held-out section alone: the corpus's targets on 30 clouds of five models no setting was
+# The held-out section alone: the corpus's targets on 66 clouds of eleven models no setting was
 # tuned on (tests/data/heldout/make.sh, from CGAL's sample data in Debian's libcgal-demo;
-# peers run live, ~15 min).
+# peers run live, ~35 min).
 .PHONY: bench-heldout
 bench-heldout: deps-bench build
 	$(PYTHON) tests/bench/run_bench.py --heldout-only --build $(BUILD) --out bench-results

@@ -7,8 +7,8 @@ and CGAL's Poisson pipelines either from the committed figures (tests/data/corpu
 the default: the peers take 5–50 s per cloud) or by running them here (`--corpus-peers live`).
 Everything is scored by gmpu-metrics; corpus_report.py turns the rows into tables.
 
-The held-out set (`make bench-heldout`) runs the same on 30 clouds that tests/data/heldout/make.sh
-samples from five meshes of CGAL's sample data that no setting was tuned on; it has no
+The held-out set (`make bench-heldout`) runs the same on 66 clouds that tests/data/heldout/make.sh
+samples from eleven meshes of CGAL's sample data that no setting was tuned on; it has no
 committed peer figures, so its peers always run here.
 """
 import csv
@@ -27,7 +27,7 @@ HELDOUT = ROOT / "tests" / "data" / "heldout"
 # What each set's make.sh writes, and where the meshes the clouds come from are.
 SETS = {
     "corpus": {"make": CORPUS / "make.sh", "count": 106, "meshes": lambda out: CORPUS / "meshes"},  # 17 × 6 + 2 × 2
-    "heldout": {"make": HELDOUT / "make.sh", "count": 30, "meshes": lambda out: out / "meshes"},  # 5 × 6
+    "heldout": {"make": HELDOUT / "make.sh", "count": 66, "meshes": lambda out: out / "meshes"},  # 11 × 6
 }
 
 VARIANTS = ("clean", "noise0.5", "noise1.0", "nonuniform", "sparse5k", "sparse1k")

@@ -9,7 +9,7 @@ same clouds, in the same run, and are scored by the same exact metrics (gmpu-met
     make bench-corpus   the corpus section alone (--corpus-only, tests/bench/corpus.py):
                         106 clouds from tests/data/corpus/make.sh against issue 13's targets;
                         `make bench` runs it too
-    make bench-heldout  the same on 30 clouds of five models never tuned on
+    make bench-heldout  the same on 66 clouds of eleven models never tuned on
                         (--heldout-only, tests/data/heldout/make.sh; peers run live)
 
 Results go to bench-results/ (results.json, results.md, *.png, renders/; the corpus section
