@@ -19,8 +19,12 @@ namespace {
 // Screening weight α = s / h, s in grid units: how hard the zero set is pulled through
 // each sample against the smoothness of the normals' integral. Strong on clean clouds (the
 // surface goes through the samples), falling with the estimated noise σ̂ (a fraction of
-// the diagonal): s = kMaxScreening · (kNoiseKnee / σ̂)^kNoisePower, bounded.
-constexpr double kNoiseKnee = 0.0035, kMinScreening = 0.5, kMaxScreening = 8.0, kNoisePower = 2.0;
+// the diagonal): s = kMaxScreening · (kNoiseKnee / σ̂)^kNoisePower, bounded. The power is
+// under 2 (a weight inverse to the noise's variance): at heavy noise σ̂ reads high where the
+// shape has detail at the estimate's scale (a gear's teeth, a porous block), and a weight
+// falling as fast as 1/σ̂² rounds that detail further; falling slower keeps more of it, at
+// the cost of a little roughness on smooth shapes.
+constexpr double kNoiseKnee = 0.0035, kMinScreening = 0.5, kMaxScreening = 8.0, kNoisePower = 1.75;
 // Where the nearby normals agree this well (the length of their weighted mean), V is their
 // unit mean direction: a mean shortened by curvature would flatten f across curved parts.
 // Below it (two sheets, a thin part's two sides) V keeps its shortened length.
