@@ -27,7 +27,7 @@ define apt_install
 endef
 
 .PHONY: all deps deps-test deps-bench build demo test test-c test-python test-node test-rust test-consumers \
-        test-sanitize bench bench-quick bench-corpus bench-heldout bench-thinwall fuzz clean plugins deps-plugins test-plugins \
+        test-sanitize bench bench-quick bench-corpus bench-heldout bench-sparse-noisy bench-thinwall fuzz clean plugins deps-plugins test-plugins \
         plugin-screenshots
 
 all: build
@@ -210,6 +210,7 @@ bench: deps-bench build
 	$(PYTHON) tests/bench/run_bench.py --build $(BUILD) --out bench-results
 	$(PYTHON) tests/bench/run_bench.py --corpus-only --corpus-peers $(CORPUS_PEERS) --build $(BUILD) --out bench-results
 	$(PYTHON) tests/bench/run_bench.py --heldout-only --build $(BUILD) --out bench-results
+	$(PYTHON) tests/bench/run_bench.py --sparse-noisy-only --build $(BUILD) --out bench-results
 	$(PYTHON) tests/bench/update_readme.py bench-results
 	$(MAKE) --no-print-directory bench-meshes
 	$(MAKE) --no-print-directory bench-dask
@@ -251,6 +252,13 @@ bench-corpus: deps-bench build
 bench-heldout: deps-bench build
 	$(PYTHON) tests/bench/run_bench.py --heldout-only --build $(BUILD) --out bench-results
 	$(PYTHON) tests/bench/update_readme.py bench-results --sections heldout
+
+# The sparse noisy section alone: the corpus's meshes at 1k and 5k points with noise
+# (tests/data/sparse_noisy/make.sh; peers run live, ~3 min).
+.PHONY: bench-sparse-noisy
+bench-sparse-noisy: deps-bench build
+	$(PYTHON) tests/bench/run_bench.py --sparse-noisy-only --build $(BUILD) --out bench-results
+	$(PYTHON) tests/bench/update_readme.py bench-results --sections sparse_noisy
 
 # gmpu alone, against quality floors: needs no peer, so CI runs it after `make test`.
 bench-quick: deps-test build

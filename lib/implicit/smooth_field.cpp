@@ -19,12 +19,20 @@ namespace {
 // Screening weight α = s / h, s in grid units: how hard the zero set is pulled through
 // each sample against the smoothness of the normals' integral. Strong on clean clouds (the
 // surface goes through the samples), falling with the estimated noise σ̂ (a fraction of
-// the diagonal): s = kMaxScreening · (kNoiseKnee / σ̂)^kNoisePower, bounded. The power is
+// the diagonal): s = kMaxScreening · (knee / σ̂)^kNoisePower, bounded. The power is
 // under 2 (a weight inverse to the noise's variance): at heavy noise σ̂ reads high where the
 // shape has detail at the estimate's scale (a gear's teeth, a porous block), and a weight
 // falling as fast as 1/σ̂² rounds that detail further; falling slower keeps more of it, at
 // the cost of a little roughness on smooth shapes.
 constexpr double kNoiseKnee = 0.0035, kMinScreening = 0.5, kMaxScreening = 8.0, kNoisePower = 1.75;
+// The knee is never below this share of the finest grid step (which follows the points'
+// spacing). Noise well under a step is finer than the grid resolves, and the gradient term
+// already averages it over a step; on a sparse cloud (a few thousand points, a step of 2–5 %
+// of the diagonal) σ̂ of 0.5–1 % is such noise, and a weaker pull there only rounds the
+// corners and thin parts the few samples carry. On dense clouds this share of a step is
+// under kNoiseKnee and changes nothing; a larger share also strengthened the pull on smooth
+// shapes of 20k points at 1 % noise, whose surface then followed the noise more.
+constexpr double kKneeSteps = 0.4;
 // Where the nearby normals agree this well (the length of their weighted mean), V is their
 // unit mean direction: a mean shortened by curvature would flatten f across curved parts.
 // Below it (two sheets, a thin part's two sides) V keeps its shortened length.
@@ -168,6 +176,7 @@ SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, 
                          LocalLevel local, ThinPartBias thin) {
     if (points.size() == 0) return;
     max_reach_ = kMaxReachSteps * spacing;
+    fine_step_ = spacing;
     level_ = level;
     local_ = local;
     thin_ = thin;
@@ -213,6 +222,7 @@ SmoothField SmoothField::with_step(double step) const {
     SmoothField field;
     field.h_ = step;
     field.max_reach_ = max_reach_;
+    field.fine_step_ = fine_step_;
     field.level_ = level_;
     field.local_ = local_;
     field.thin_ = thin_;
@@ -477,7 +487,9 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
                 }
     std::vector<Eigen::Vector3d>().swap(field);
 
-    const double knee = noise > 0.0 ? kNoiseKnee / noise : INFINITY;
+    const double box_diagonal = points.world_diagonal() * points.normalisation().scale;  // normalised
+    const double knee_noise = std::max(kNoiseKnee, kKneeSteps * fine_step_ / box_diagonal);
+    const double knee = noise > 0.0 ? knee_noise / noise : INFINITY;
     const double alpha =
         std::clamp(kMaxScreening * std::pow(knee, kNoisePower), kMinScreening, kMaxScreening) / h_;
     Eigen::VectorXd diagonal = edge_diagonal;  // of the whole matrix: the preconditioner

@@ -11,7 +11,8 @@
 // grid steps of the points, 0 farther, fading where the points lie to one side of a node
 // rather than under it: past a thin part's edge) and the
 // screening term pulls the zero set through the points, all weighted alike (Aᵢ: their mean
-// area), with α falling as the estimated noise grows; f is then shifted so that its median
+// area), with α falling as the estimated noise grows past a knee (at least 0.4 of the finest
+// grid step: noise under it is finer than the grid resolves); f is then shifted so that its median
 // over the samples is 0 (its mean, beside thin walls: ZeroLevel), and then, cell by cell
 // of a few grid steps, by what is left of the samples' median there beyond the noise
 // (follow_local_level), and on parts thinner than the noise, corrected for the outward bias
@@ -158,6 +159,7 @@ private:
     double h_ = 0.0;
     double min_trust_ = 0.0;
     double max_reach_ = 0.0;          // the longest splat radius, before the cell diagonal
+    double fine_step_ = 0.0;          // the finest level's grid step, which the screening's knee reads
     ZeroLevel level_ = ZeroLevel::median;
     LocalLevel local_ = LocalLevel::follow;
     ThinPartBias thin_ = ThinPartBias::correct;

@@ -9,7 +9,9 @@ Everything is scored by gmpu-metrics; corpus_report.py turns the rows into table
 
 The held-out set (`make bench-heldout`) runs the same on 66 clouds that tests/data/heldout/make.sh
 samples from eleven meshes of CGAL's sample data that no setting was tuned on; it has no
-committed peer figures, so its peers always run here.
+committed peer figures, so its peers always run here. So has the sparse noisy set (`make
+bench-sparse-noisy`): 51 clouds of the corpus's closed meshes, few points and noisy at once
+(tests/data/sparse_noisy/make.sh).
 """
 import csv
 import json
@@ -24,13 +26,16 @@ CORPUS = ROOT / "tests" / "data" / "corpus"
 PEERS_TSV = CORPUS / "peers.tsv"
 IPSR_TSV = CORPUS / "ipsr_reference.tsv"
 HELDOUT = ROOT / "tests" / "data" / "heldout"
+SPARSE_NOISY = ROOT / "tests" / "data" / "sparse_noisy"
 # What each set's make.sh writes, and where the meshes the clouds come from are.
 SETS = {
     "corpus": {"make": CORPUS / "make.sh", "count": 106, "meshes": lambda out: CORPUS / "meshes"},  # 17 × 6 + 2 × 2
     "heldout": {"make": HELDOUT / "make.sh", "count": 66, "meshes": lambda out: out / "meshes"},  # 11 × 6
+    "sparse_noisy": {"make": SPARSE_NOISY / "make.sh", "count": 51, "meshes": lambda out: CORPUS / "meshes"},  # 17 × 3
 }
 
 VARIANTS = ("clean", "noise0.5", "noise1.0", "nonuniform", "sparse5k", "sparse1k")
+SPARSE_NOISY_VARIANTS = ("sparse1k-noise0.5", "sparse1k-noise1.0", "sparse5k-noise1.0")
 OPEN_MESHES = ("elephant-with-holes", "mech-holes-shark")
 # peers.tsv's names for the two peers, and the live pipelines that stand for them.
 REFERENCE_PEERS = {"cgal_poisson": "cgal", "open3d_poisson_d8": "open3d_d8"}

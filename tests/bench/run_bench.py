@@ -11,9 +11,12 @@ same clouds, in the same run, and are scored by the same exact metrics (gmpu-met
                         `make bench` runs it too
     make bench-heldout  the same on 66 clouds of eleven models never tuned on
                         (--heldout-only, tests/data/heldout/make.sh; peers run live)
+    make bench-sparse-noisy  the same on 51 clouds of the corpus's meshes, 1k/5k points with
+                        noise (--sparse-noisy-only, tests/data/sparse_noisy/make.sh; peers live)
 
 Results go to bench-results/ (results.json, results.md, *.png, renders/; the corpus section
-in bench-results/corpus/: corpus.json, corpus.md; the held-out one in bench-results/heldout/); then tests/bench/update_readme.py puts
+in bench-results/corpus/: corpus.json, corpus.md; the held-out one in bench-results/heldout/, the sparse noisy one in
+bench-results/sparse_noisy/); then tests/bench/update_readme.py puts
 the summaries into the README.
 """
 import argparse
@@ -305,6 +308,8 @@ def main():
                     help="only the corpus section (tests/data/corpus, issue 13)")
     ap.add_argument("--heldout-only", action="store_true",
                     help="only the held-out section (tests/data/heldout: models never tuned on)")
+    ap.add_argument("--sparse-noisy-only", action="store_true",
+                    help="only the sparse noisy section (tests/data/sparse_noisy: 1k/5k points with noise)")
     ap.add_argument("--corpus-peers", choices=("reference", "live"), default="reference",
                     help="the peers on the corpus: committed figures (peers.tsv) or run here")
     ap.add_argument("--corpus-repeats", type=int, default=1,
@@ -323,8 +328,8 @@ def main():
         sys.exit(f"{metrics_exe} is missing: build first (make build)")
     if args.quick:
         return quick(args, metrics_exe, args.build)
-    args.corpus_set = "heldout" if args.heldout_only else "corpus"
-    if args.corpus_only or args.heldout_only:
+    args.corpus_set = "heldout" if args.heldout_only else "sparse_noisy" if args.sparse_noisy_only else "corpus"
+    if args.corpus_only or args.heldout_only or args.sparse_noisy_only:
         return corpus_section(args, metrics_exe, args.build)
     return full(args, metrics_exe, args.build)
 

@@ -9,6 +9,8 @@ Each section replaces what lies between its two marker lines in the README:
           (or, failing those, `<!-- results:begin -->` / `<!-- results:end -->`)
   corpus  RESULTS_DIR/corpus/corpus.md   between `<!-- corpus:begin -->` and `<!-- corpus:end -->`
   heldout RESULTS_DIR/heldout/corpus.md  between `<!-- heldout:begin -->` and `<!-- heldout:end -->`
+  sparse_noisy RESULTS_DIR/sparse_noisy/corpus.md  between `<!-- sparse_noisy:begin -->` and
+          `<!-- sparse_noisy:end -->`
 A section whose file is missing is skipped (said on stdout) unless it was asked for by
 --sections; the plots and renders a section links to are copied into the assets folder
 (bench-results/ itself is not committed). Exits 1 when the README lacks a section's markers,
@@ -26,6 +28,7 @@ SECTIONS = {
                              ("<!-- results:begin -->", "<!-- results:end -->")]),
     "corpus": ("corpus/corpus.md", [("<!-- corpus:begin -->", "<!-- corpus:end -->")]),
     "heldout": ("heldout/corpus.md", [("<!-- heldout:begin -->", "<!-- heldout:end -->")]),
+    "sparse_noisy": ("sparse_noisy/corpus.md", [("<!-- sparse_noisy:begin -->", "<!-- sparse_noisy:end -->")]),
 }
 
 
@@ -63,7 +66,7 @@ def main():
     ap.add_argument("--readme", type=Path, default=ROOT / "README.md")
     ap.add_argument("--assets", type=Path, default=ROOT / "docs" / "bench",
                     help="where the linked PNGs are copied (committed with the README)")
-    ap.add_argument("--sections", default="", help="comma-separated: bench, corpus, heldout (default: "
+    ap.add_argument("--sections", default="", help="comma-separated: bench, corpus, heldout, sparse_noisy (default: "
                     "every section whose file the results folder has)")
     args = ap.parse_args()
 

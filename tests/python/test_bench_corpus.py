@@ -120,3 +120,24 @@ def test_the_heldout_models_are_not_in_the_corpus():
     assert not set(models) & (corpus_meshes | shared_meshes)
     assert corpus.SETS["heldout"]["count"] == 6 * len(models)
     assert corpus.SETS["heldout"]["meshes"](Path("/x")) == Path("/x/meshes")
+
+
+def test_the_sparse_noisy_set_is_judged_without_an_orientation_target():
+    # Issue 13 sets orientation targets per density or per noise level, none for both at once:
+    # these clouds are judged on F and the noise estimate only.
+    assert corpus.variant_of("bear_sparse1k-noise0.5") == "sparse1k-noise0.5"
+    r = row("bear_sparse1k-noise1.0", 0.01, orientation_accuracy=0.5, noise_estimate=0.011)
+    c = corpus_report.checks(r)
+    assert "orientation" not in c and c["noise"] is True and c["fscore_0.5_peer"] is True
+    text = corpus_report.section({"rows": [r], "set": "sparse_noisy", "peer_source": "live", "ipsr": {}}, "a machine")
+    assert "tests/data/sparse_noisy/make.sh" in text and "| sparse1k-noise1.0 | 1 |" in text
+    assert "orientation ≥" not in text and "peers.tsv" not in text
+
+
+def test_the_sparse_noisy_set_samples_the_corpus_meshes():
+    script = (REPO / "tests" / "data" / "sparse_noisy" / "make.sh").read_text()
+    models = next(l for l in script.splitlines() if l.startswith("closed=")).split("=", 1)[1].strip('"').split()
+    corpus_meshes = {p.stem for p in (REPO / "tests" / "data" / "corpus" / "meshes").iterdir()}
+    assert len(models) * 3 == corpus.SETS["sparse_noisy"]["count"] and set(models) <= corpus_meshes
+    for variant in corpus.SPARSE_NOISY_VARIANTS:
+        assert f"_{variant}.ply" in script and variant in corpus_report.VARIANT_ORDER
