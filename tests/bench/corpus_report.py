@@ -261,16 +261,17 @@ HELDOUT_INTRO = (
     "noise σ 0.5 % and 1 % of the diagonal, ten-fold nonuniform density, 5k and 1k points)")
 
 
-def heldout_section(corpus, machine, load_note=""):
-    """The README's held-out section: the corpus's targets on models never tuned on."""
+def live_peers_section(intro, targets_heading, corpus, machine, load_note=""):
+    """A README section of a set whose peers run in the benchmark (no committed figures, no
+    iPSR): `intro` describes the clouds, `targets_heading` titles the targets' list."""
     rows = corpus["rows"]
     return (
-        f"Measured on {machine}. {HELDOUT_INTRO}, scored by gmpu-metrics like the corpus. Peer: the "
+        f"Measured on {machine}. {intro}. Peer: the "
         "better of Open3D's (Poisson depth 8) and CGAL's Poisson pipelines, **run in this benchmark** "
         "(time: normals + orientation + surface), column by column. Poisson(gmpu): Open3D's screened "
         "Poisson (depth 8, trimmed at the 1 % density quantile) on gmpu's own oriented normals. ✓/✗: "
         "the issue-13 target met/missed on that cloud." + load_note + "\n\n"
-        "#### Targets (issue 13, on models not tuned on)\n\n" + targets(rows, []) + "\n"
+        f"#### {targets_heading}\n\n" + targets(rows, []) + "\n"
         "#### Per variant\n\n" + variant_table(rows) + "\n"
         "#### Per cloud\n\n<details><summary>" + f"{len(rows)} clouds</summary>\n\n"
         + cloud_table(rows) + "\n</details>\n")
@@ -284,28 +285,14 @@ SPARSE_NOISY_INTRO = (
     "grid*), so they are not held out")
 
 
-def sparse_noisy_section(corpus, machine, load_note=""):
-    """The README's sparse noisy section: the corpus's targets where they apply (issue 13 sets
-    no orientation target for these densities)."""
-    rows = corpus["rows"]
-    return (
-        f"Measured on {machine}. {SPARSE_NOISY_INTRO}; scored by gmpu-metrics like the corpus. Peer: "
-        "the better of Open3D's (Poisson depth 8) and CGAL's Poisson pipelines, **run in this "
-        "benchmark** (time: normals + orientation + surface), column by column. Poisson(gmpu): "
-        "Open3D's screened Poisson (depth 8, trimmed at the 1 % density quantile) on gmpu's own "
-        "oriented normals. ✓/✗: the issue-13 target met/missed on that cloud." + load_note + "\n\n"
-        "#### Targets (issue 13's, where they apply)\n\n" + targets(rows, []) + "\n"
-        "#### Per variant\n\n" + variant_table(rows) + "\n"
-        "#### Per cloud\n\n<details><summary>" + f"{len(rows)} clouds</summary>\n\n"
-        + cloud_table(rows) + "\n</details>\n")
-
-
 def section(corpus, machine, load_note=""):
     """The README's corpus section (markdown)."""
-    if corpus.get("set") == "heldout":
-        return heldout_section(corpus, machine, load_note)
-    if corpus.get("set") == "sparse_noisy":
-        return sparse_noisy_section(corpus, machine, load_note)
+    if corpus.get("set") == "heldout":  # the corpus's targets on models never tuned on
+        return live_peers_section(HELDOUT_INTRO + ", scored by gmpu-metrics like the corpus",
+                                  "Targets (issue 13, on models not tuned on)", corpus, machine, load_note)
+    if corpus.get("set") == "sparse_noisy":  # issue 13 sets no orientation target for these
+        return live_peers_section(SPARSE_NOISY_INTRO + "; scored by gmpu-metrics like the corpus",
+                                  "Targets (issue 13's, where they apply)", corpus, machine, load_note)
     rows = corpus["rows"]
     comparison = ipsr_comparison(rows, corpus.get("ipsr", {}))
     live = corpus["peer_source"] == "live"

@@ -179,11 +179,11 @@ void same_field_on_any_thread_count(void **) {
 }
 
 // Where the zero set crosses the ray from the centre along the unit `direction` (in radii;
-// 0 if never).
-double ray_crossing(const SmoothField &field, const Cloud &c, const Vector3d &direction) {
+// 0 if not within `reach` radii).
+double ray_crossing(const SmoothField &field, const Cloud &c, const Vector3d &direction, double reach = 1.5) {
     const double h = field.spacing();
     double before = 0.0;
-    for (double t = 0.0; t < 1.5 * c.radius; t += 0.25 * h) {
+    for (double t = 0.0; t < reach * c.radius; t += 0.25 * h) {
         double f;
         if (!field.value(c.centre + t * direction, f, nullptr)) break;
         if (t > 0.0 && f <= 0.0) return (t - 0.25 * h * f / (f - before)) / c.radius;
@@ -241,6 +241,20 @@ void resolved_follows_the_new_normals(void **) {
     assert_true(std::fabs(at_second - at_direct) < 0.25 * std::fabs(at_first - at_direct));
 }
 
+// A cloud of a shape centred on the world origin, with unit radius in world units: its
+// points, their `outward` normals, noise `sigma` and the shape's area (both world units).
+Cloud centred_cloud(const std::vector<double> &xyz, const std::vector<Vector3d> &outward, double sigma, double area) {
+    Cloud c;
+    const size_t n = outward.size();
+    c.points = PointSet::from_array(xyz.data(), n, 0, 1);
+    const double scale = c.points.normalisation().scale;  // world to normalised lengths
+    c.centre = c.points.normalisation().to_unit(Vector3d::Zero());
+    c.radius = scale;
+    c.sigma = sigma * scale;
+    measure(c, outward, area * scale * scale / double(n));
+    return c;
+}
+
 // A thin ring under noise comparable to its thickness (a torus whose tube radius is 1.5 σ):
 // a sample pushed outward has f more negative the farther it goes, one pushed inward past
 // the tube's axis has f falling again, so the samples' values have a long negative tail (as
@@ -271,14 +285,7 @@ Cloud noisy_ring(RingNoise noise = RingNoise::normal, double sigma = kTubeNoise)
         xyz.insert(xyz.end(), {p.x(), p.y(), p.z()});
         outward.push_back(d);
     }
-    Cloud c;
-    c.points = PointSet::from_array(xyz.data(), n, 0, 1);
-    const double scale = c.points.normalisation().scale;  // world to normalised lengths
-    c.centre = c.points.normalisation().to_unit(Vector3d::Zero());
-    c.radius = scale;
-    c.sigma = sigma * scale;
-    measure(c, outward, 4.0 * M_PI * M_PI * kRing * kTube * scale * scale / double(n));
-    return c;
+    return centred_cloud(xyz, outward, sigma, 4.0 * M_PI * M_PI * kRing * kTube);
 }
 
 // The noisy ring's zero set along rays out of the tube's axis, around it and along the ring:
@@ -370,34 +377,17 @@ Cloud noisy_cube(size_t n, double sigma) {
         xyz.insert(xyz.end(), {p.x(), p.y(), p.z()});
         outward.push_back(d);
     }
-    Cloud c;
-    c.points = PointSet::from_array(xyz.data(), n, 0, 1);
-    const double scale = c.points.normalisation().scale;  // world to normalised lengths
-    c.centre = c.points.normalisation().to_unit(Vector3d::Zero());
-    c.radius = scale;
-    c.sigma = sigma * scale;
-    measure(c, outward, 24.0 * scale * scale / double(n));
-    return c;
+    return centred_cloud(xyz, outward, sigma, 24.0);
 }
 
 // How far the zero set falls short of the cube's corners: the mean, over the 8 corners, of
 // √3 less where f crosses zero along the ray from the centre (world units).
-double corner_rounding(const SmoothField &field, const Cloud &c, double h) {
+double corner_rounding(const SmoothField &field, const Cloud &c) {
     double sum = 0.0;
     for (int a = 0; a < 8; ++a) {
         const Vector3d d = Vector3d(a & 1 ? 1 : -1, a & 2 ? 1 : -1, a & 4 ? 1 : -1).normalized();
-        const double step = 0.05 * h;
-        double before = 0.0, crossing = NAN;
-        for (double t = 0.0; t < 3.0 * c.radius; t += step) {
-            double f;
-            if (!field.value(c.centre + t * d, f, nullptr)) break;
-            if (t > 0.0 && f <= 0.0) {
-                crossing = (t - step * f / (f - before)) / c.radius;
-                break;
-            }
-            before = f;
-        }
-        assert_false(std::isnan(crossing));
+        const double crossing = ray_crossing(field, c, d, 3.0);
+        assert_true(crossing > 0.0);
         sum += std::sqrt(3.0) - crossing;
     }
     return sum / 8.0;
@@ -419,7 +409,7 @@ void sparse_cube_keeps_its_corners_at_noise(void **) {
     const SmoothField noisy(c.points, c.measures, h, 2.0 * h, 0.3 * spacing / diagonal, ZeroLevel::median, 1e10,
                             workers, quiet),
         noise_free(c.points, c.measures, h, 2.0 * h, 0.0, ZeroLevel::median, 1e10, workers, quiet);
-    const double rounded = corner_rounding(noisy, c, h), reference = corner_rounding(noise_free, c, h);
+    const double rounded = corner_rounding(noisy, c), reference = corner_rounding(noise_free, c);
     print_message("# sparse noisy cube (noise %.2f %% of the diagonal, grid step %.2f %%): corners %.4f short, "
                   "%.4f without noise\n", 100.0 * 0.3 * spacing / diagonal, 100.0 * spacing / diagonal, rounded,
                   reference);
