@@ -61,6 +61,19 @@ constexpr double kMaxReachSteps = 12.0;
 // other and, over a misoriented patch, makes f rise along the wrong normals over the
 // whole band instead of a few cells.
 constexpr double kNormalReachSteps = 3.0;
+// Across a sheet (along a point's own normal) the normals reach only kAcrossShare of that,
+// but at least kAcrossSigmas noise deviations: a node then takes its V from the sheet
+// whose plane passes nearest, not from both sides of a part thinner than the reach, whose
+// normals cancel there and leave f only smooth (a sparse thin part comes out thinner or
+// detached). Along the sheet the reach is unchanged, so V still bridges the gaps between
+// sparse samples; the noise floor keeps a noisy sheet's spread points in each node's mean,
+// where a narrower kernel samples the noise and the surface grows handles. kAcrossIsotropic
+// of each weight stays round, so a node that only one sheet reaches keeps its unit V.
+constexpr double kAcrossShare = 1.0 / 3.0, kAcrossSigmas = 4.0, kAcrossIsotropic = 0.05;
+// Only under noise does the cancelling cost a thin part its faces: without noise the
+// samples' full pull holds each face, and the narrowing there only opened holes in sparse
+// thin walls. It grows with σ̂ to its full effect at kAcrossNoiseSteps of a grid step.
+constexpr double kAcrossNoiseSteps = 0.1;
 // V fades where a node lies off the side of the points that reach it rather than over them:
 // from kOverhangFull to kOverhangNone of the normals' reach between the node and the
 // points' weighted centre, measured across their mean normal. Past a thin part's edge (a
@@ -349,6 +362,10 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
         if (block_slot_[b] >= 0) slot_block[size_t(block_slot_[b])] = int64_t(b);
     // V's reach from a point (capped by the point's own radius in the splat).
     const double normal_reach = (kNormalReachSteps + std::sqrt(3.0)) * h_;
+    const double sigma = noise * points.world_diagonal() * points.normalisation().scale;
+    const double across_reach = std::min(normal_reach, std::max(kAcrossShare * normal_reach, kAcrossSigmas * sigma));
+    const double across_stretch = std::min(sigma / (kAcrossNoiseSteps * h_), 1.0) *
+                                  ((normal_reach / across_reach) * (normal_reach / across_reach) - 1.0);
     Progress splat_progress = progress.slice(0.05, 0.2);
     parallel_for(0, size_t(slots), workers, splat_progress, [&](size_t slot) {
         const int64_t b = slot_block[slot];
@@ -371,7 +388,11 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
                         if (w <= 0.0) continue;
                         const size_t s = slot * BBB + size_t(x - base[0] + B * (y - base[1] + B * (z - base[2])));
                         wsum[s] += w;
-                        const double wn = weight(d2, normal_r2);
+                        const double across = (q - p).dot(nrm);
+                        const double round = weight(d2, normal_r2);
+                        const double wn = across_stretch > 0.0 ? kAcrossIsotropic * round + (1.0 - kAcrossIsotropic) *
+                                                                     weight(d2 + across_stretch * across * across, normal_r2)
+                                                               : round;
                         normal_wsum[s] += wn;
                         normal[s] += wn * nrm;
                         offset[s] += wn * (p - q);
@@ -602,7 +623,6 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
         });
         rz_rr = next;
     }
-    const double sigma = noise * points.world_diagonal() * points.normalisation().scale;
     Eigen::VectorXd thin_bias;
     if (!whole_box && thin_ == ThinPartBias::correct && sigma > 0.0)
         thin_bias = thin_part_bias(x, sigma, workers, progress);
