@@ -388,11 +388,12 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
                         if (w <= 0.0) continue;
                         const size_t s = slot * BBB + size_t(x - base[0] + B * (y - base[1] + B * (z - base[2])));
                         wsum[s] += w;
-                        const double across = (q - p).dot(nrm);
-                        const double round = weight(d2, normal_r2);
-                        const double wn = across_stretch > 0.0 ? kAcrossIsotropic * round + (1.0 - kAcrossIsotropic) *
-                                                                     weight(d2 + across_stretch * across * across, normal_r2)
-                                                               : round;
+                        double wn = weight(d2, normal_r2);
+                        if (across_stretch > 0.0) {
+                            const double across = (q - p).dot(nrm);
+                            wn = kAcrossIsotropic * wn +
+                                 (1.0 - kAcrossIsotropic) * weight(d2 + across_stretch * across * across, normal_r2);
+                        }
                         normal_wsum[s] += wn;
                         normal[s] += wn * nrm;
                         offset[s] += wn * (p - q);

@@ -19,15 +19,9 @@ constexpr double kSmoothFromNoise = 0.003;
 constexpr int kMaxResolution = 1024;
 // From this estimated noise on (a fraction of the diagonal) the smooth field is solved a
 // second time from its own normals: there the blend's normals are noisy enough that their
-// smoothed version moves the surface; below it the second solve changes little and costs
-// as much.
+// smoothed version moves the surface; below it, on a dense cloud, the second solve changes
+// little and costs as much (sparse clouds: solve_smooth_surface).
 constexpr double kResolveFromNoise = 0.0075;
-// A sparse cloud (under kGuideBelowPoints) is solved a second time from kSmoothFromNoise on:
-// there the orientation leaves a few percent of wrong normals in patches, and the first
-// field, pulled by them, fills the space between nearby parts (legs, a tail) where no point
-// lies; its own normals at the points agree with their neighbours and outvote the patches.
-// The second solve costs as much as the first, which on a sparse cloud is a fraction of a
-// second; on dense clouds below kResolveFromNoise it changes little.
 // From this estimated noise on the field is corrected for the noise's outward bias on thin
 // parts (SmoothField's ThinPartBias). The bias goes with σ²; at half this noise it is a
 // quarter as large, and the parts the correction takes for thin there are more often a CAD
@@ -146,6 +140,11 @@ std::shared_ptr<const SmoothField> solve_smooth_surface(const Params &params, Su
     // Solved again from its own normals at the points (where the neighbours agree): they
     // are the blend's normals averaged over the field's neighbourhood, far less noisy than
     // the blend's own at noise, and scattered flips are corrected.
+    // A sparse cloud (under kGuideBelowPoints) is solved again wherever it has a smooth
+    // surface at all (kSmoothFromNoise): there the orientation leaves a few percent of the
+    // normals wrong in patches, and the first field, pulled by them, fills the space between
+    // nearby parts (legs, a tail) where no point lies; the field's own normals outvote the
+    // patches. A sparse cloud's solve takes a fraction of a second.
     const bool resolve = noise_share >= kResolveFromNoise || (!dense(points) && noise_share >= kSmoothFromNoise);
     if (!resolve) {
         progress.report(1.0);
