@@ -19,7 +19,8 @@ namespace {
 // Screening weight α = s / h, s in grid units: how hard the zero set is pulled through
 // each sample against the smoothness of the normals' integral. Strong on clean clouds (the
 // surface goes through the samples), falling with the estimated noise σ̂ (a fraction of
-// the diagonal): s = kMaxScreening · (knee / σ̂)^kNoisePower, bounded. The power is
+// the diagonal): s = kMaxScreening · (knee / σ̂)^kNoisePower, bounded (on a sparse cloud
+// s and its bound are multiplied by the Sparseness factor). The power is
 // under 2 (a weight inverse to the noise's variance): at heavy noise σ̂ reads high where the
 // shape has detail at the estimate's scale (a gear's teeth, a porous block), and a weight
 // falling as fast as 1/σ̂² rounds that detail further; falling slower keeps more of it, at
@@ -67,8 +68,10 @@ constexpr double kNormalReachSteps = 3.0;
 // normals cancel there and leave f only smooth (a sparse thin part comes out thinner or
 // detached). Along the sheet the reach is unchanged, so V still bridges the gaps between
 // sparse samples; the noise floor keeps a noisy sheet's spread points in each node's mean,
-// where a narrower kernel samples the noise and the surface grows handles. kAcrossIsotropic
-// of each weight stays round, so a node that only one sheet reaches keeps its unit V.
+// where a narrower kernel samples the noise and the surface grows handles. On a sparse
+// cloud the floor is divided by the Sparseness factor: a node's mean holds few points there
+// anyway, and what the floor cost were legs and blades. kAcrossIsotropic of each weight
+// stays round, so a node that only one sheet reaches keeps its unit V.
 constexpr double kAcrossShare = 1.0 / 3.0, kAcrossSigmas = 4.0, kAcrossIsotropic = 0.05;
 // Only under noise does the cancelling cost a thin part its faces: without noise the
 // samples' full pull holds each face, and the narrowing there only opened holes in sparse
@@ -186,13 +189,14 @@ void SmoothField::for_each_node(Workers &workers, Progress &progress, const Visi
 
 SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, double spacing, double min_trust,
                          double noise, ZeroLevel level, double max_memory, Workers &workers, Progress &progress,
-                         LocalLevel local, ThinPartBias thin) {
+                         LocalLevel local, ThinPartBias thin, Sparseness sparseness) {
     if (points.size() == 0) return;
     max_reach_ = kMaxReachSteps * spacing;
     fine_step_ = spacing;
     level_ = level;
     local_ = local;
     thin_ = thin;
+    sparseness_ = sparseness;
     {
         // The fine band takes more memory than the coarser bands: laid out first, its memory
         // check fails a cloud too scattered for the budget before the outer field and the
@@ -239,6 +243,7 @@ SmoothField SmoothField::with_step(double step) const {
     field.level_ = level_;
     field.local_ = local_;
     field.thin_ = thin_;
+    field.sparseness_ = sparseness_;
     return field;
 }
 
@@ -363,7 +368,8 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
     // V's reach from a point (capped by the point's own radius in the splat).
     const double normal_reach = (kNormalReachSteps + std::sqrt(3.0)) * h_;
     const double sigma = noise * points.world_diagonal() * points.normalisation().scale;
-    const double across_reach = std::min(normal_reach, std::max(kAcrossShare * normal_reach, kAcrossSigmas * sigma));
+    const double across_floor = kAcrossSigmas * sigma / sparseness_.factor;
+    const double across_reach = std::min(normal_reach, std::max(kAcrossShare * normal_reach, across_floor));
     const double across_stretch = std::min(sigma / (kAcrossNoiseSteps * h_), 1.0) *
                                   ((normal_reach / across_reach) * (normal_reach / across_reach) - 1.0);
     Progress splat_progress = progress.slice(0.05, 0.2);
@@ -512,8 +518,8 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
     const double box_diagonal = points.world_diagonal() * points.normalisation().scale;  // normalised
     const double knee_noise = std::max(kNoiseKnee, kKneeSteps * fine_step_ / box_diagonal);
     const double knee = noise > 0.0 ? knee_noise / noise : INFINITY;
-    const double alpha =
-        std::clamp(kMaxScreening * std::pow(knee, kNoisePower), kMinScreening, kMaxScreening) / h_;
+    const double pull = kMaxScreening * sparseness_.factor;
+    const double alpha = std::clamp(pull * std::pow(knee, kNoisePower), kMinScreening, pull) / h_;
     Eigen::VectorXd diagonal = edge_diagonal;  // of the whole matrix: the preconditioner
     // Every sample weighs the same (the mean area): a point's area comes from its
     // neighbours' distances, and with noise the points pushed outward of a convex part are

@@ -71,6 +71,18 @@ enum class LocalLevel { follow, off };
 // (thin_part_bias below); off only to observe the levels alone.
 enum class ThinPartBias { correct, off };
 
+// How much sparser than a dense cloud the samples are, as a factor of at least 1
+// (pipeline/smooth_surface.cpp sets it for a sparse cloud's smooth surface; 1 elsewhere).
+// On a sparse cloud the normals are the weaker half of the data: the orientation leaves a
+// few percent of them wrong in patches, and a thin part (a leg, a tail, a blade), one or two
+// grid steps thick, has its faces' normals cancel in V, so that f, only smooth there, lets
+// the part thin out or vanish. The samples still mark where the part is: the screening
+// weight (and its noise-free ceiling) grows by the factor, and the noise floor of V's
+// narrowing across a sheet (kAcrossSigmas) shrinks by it.
+struct Sparseness {
+    double factor = 1.0;
+};
+
 class SmoothField {
 public:
     SmoothField() = default;
@@ -82,7 +94,8 @@ public:
     // to 1.
     SmoothField(const PointSet &points, const PointMeasures &measures, double spacing, double min_trust, double noise,
                 ZeroLevel level, double max_memory, Workers &workers, Progress &progress,
-                LocalLevel local = LocalLevel::follow, ThinPartBias thin = ThinPartBias::correct);
+                LocalLevel local = LocalLevel::follow, ThinPartBias thin = ThinPartBias::correct,
+                Sparseness sparseness = {});
 
     // f and optionally ∇f at x: the band's where it is defined, else the outer field's;
     // false outside the outer field's box (f is then undefined).
@@ -163,6 +176,7 @@ private:
     ZeroLevel level_ = ZeroLevel::median;
     LocalLevel local_ = LocalLevel::follow;
     ThinPartBias thin_ = ThinPartBias::correct;
+    Sparseness sparseness_;
     int64_t nodes_[3] = {0, 0, 0};     // per axis
     int64_t blocks_[3] = {0, 0, 0};    // per axis
     std::vector<int32_t> block_slot_;  // per block: its slot in node_index_ (÷ B³), or -1

@@ -55,6 +55,15 @@ constexpr size_t kStrayTestBelowPoints = 200000;
 
 bool dense(const PointSet &points) { return points.size() >= kGuideBelowPoints; }
 
+// A sparse cloud's smooth surface leans on its samples more than a dense one's
+// (Sparseness, implicit/smooth_field.hpp), by √(kGuideBelowPoints / points): continuous
+// where a cloud turns dense. Where the smooth field only guides the blend, the blend holds
+// the samples already.
+Sparseness sparseness(SurfaceKind kind, const PointSet &points) {
+    if (kind != SurfaceKind::smooth || dense(points) || points.size() == 0) return {};
+    return {std::sqrt(double(kGuideBelowPoints) / double(points.size()))};
+}
+
 double noise_fraction(const PointSet &points, double noise) {
     const double diagonal = points.world_diagonal() * points.normalisation().scale;  // normalised
     return diagonal > 0.0 ? noise / diagonal : 0.0;
@@ -136,7 +145,7 @@ std::shared_ptr<const SmoothField> solve_smooth_surface(const Params &params, Su
              second_progress = progress.slice(0.75, 1.0);
     const ThinPartBias thin = noise_share >= kThinBiasFromNoise ? ThinPartBias::correct : ThinPartBias::off;
     SmoothField first(points, measures, h, 2.0 * h, noise_share, level, params.max_memory, workers, first_progress,
-                      LocalLevel::follow, thin);
+                      LocalLevel::follow, thin, sparseness(kind, points));
     // Solved again from its own normals at the points (where the neighbours agree): they
     // are the blend's normals averaged over the field's neighbourhood, far less noisy than
     // the blend's own at noise, and scattered flips are corrected.
