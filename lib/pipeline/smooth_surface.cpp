@@ -22,10 +22,13 @@ constexpr int kMaxResolution = 1024;
 // smoothed version moves the surface; below it, on a dense cloud, the second solve changes
 // little and costs as much (sparse clouds: solve_smooth_surface).
 constexpr double kResolveFromNoise = 0.0075;
-// From this estimated noise on the field is corrected for the noise's outward bias on thin
-// parts (SmoothField's ThinPartBias). The bias goes with σ²; at half this noise it is a
-// quarter as large, and the parts the correction takes for thin there are more often a CAD
-// part's fins and webs, whose rounding the bias offsets, than tubes made too thick.
+// From this estimated noise on a dense cloud's field is corrected for the noise's outward
+// bias on thin parts (SmoothField's ThinPartBias). The bias goes with σ²; at half this noise
+// it is a quarter as large, and the parts the correction takes for thin there are more
+// often a CAD part's fins and webs, whose rounding the bias offsets, than tubes made too
+// thick. A sparse cloud's field is not corrected: there a thin part comes out too thin
+// rather than too thick (its faces' normals cancel in V, few samples hold it), and the
+// correction would take away what the samples kept.
 constexpr double kThinBiasFromNoise = 0.0075;
 // GMPU_PARAM_SURFACE = 2 guides the blend on noise-free clouds of fewer points than this:
 // there leaves hold few points and the blend strays past thin parts' ends. On denser clouds the blend alone is mostly as close, and the smooth
@@ -143,7 +146,8 @@ std::shared_ptr<const SmoothField> solve_smooth_surface(const Params &params, Su
     const double noise_share = noise_fraction(points, noise);
     Progress first_progress = progress.slice(0.0, 0.7), normals_progress = progress.slice(0.7, 0.75),
              second_progress = progress.slice(0.75, 1.0);
-    const ThinPartBias thin = noise_share >= kThinBiasFromNoise ? ThinPartBias::correct : ThinPartBias::off;
+    const ThinPartBias thin =
+        dense(points) && noise_share >= kThinBiasFromNoise ? ThinPartBias::correct : ThinPartBias::off;
     SmoothField first(points, measures, h, 2.0 * h, noise_share, level, params.max_memory, workers, first_progress,
                       LocalLevel::follow, thin, sparseness(kind, points));
     // Solved again from its own normals at the points (where the neighbours agree): they

@@ -1,11 +1,12 @@
 // A sparse noisy cloud's smooth surface leans on its samples (Sparseness,
-// implicit/smooth_field.hpp): the screening grows with the sparseness, and the noise floor of
-// V's narrowing across a sheet shrinks with it. A gear of 1,000 points at 1 % noise: its
-// teeth and web are one or two grid steps thick, their faces' normals cancel in V and some
-// are wrong in patches, and with a dense cloud's field the teeth thinned out and the web
-// broke. Over three draws, the share of the true surface within 1 % of the diagonal
-// (recall) was 0.39 without the stronger screening and 0.44 without the lower floor; with
-// both it is 0.50.
+// implicit/smooth_field.hpp: the screening grows with the sparseness, and the noise floor of
+// V's narrowing across a sheet shrinks with it), and its thin parts are not corrected for
+// the noise's outward bias (pipeline/smooth_surface.cpp, kThinBiasFromNoise). A gear of
+// 1,000 points at 1 % noise: its teeth and web are one or two grid steps thick, their faces'
+// normals cancel in V and some are wrong in patches, and with a dense cloud's field the
+// teeth thinned out and the web broke. Over three draws, the share of the true surface
+// within 1 % of the diagonal (recall) is 0.54; without the stronger screening 0.41, without
+// the lower floor 0.46, with the thin parts' correction 0.50.
 #include <cmath>
 #include <vector>
 
@@ -44,8 +45,8 @@ void sparse_noisy_gear_keeps_its_thin_parts(void **) {
         fscore += c.fscores[0].fscore / 3.0;
     }
     print_message("# mean recall %.3f, F %.3f\n", recall, fscore);
-    assert_true(recall > 0.47);
-    assert_true(fscore > 0.49);
+    assert_true(recall > 0.52);
+    assert_true(fscore > 0.52);
 }
 
 }  // namespace
