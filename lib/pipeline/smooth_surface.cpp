@@ -146,8 +146,8 @@ std::shared_ptr<const SmoothField> solve_smooth_surface(const Params &params, Su
     const double noise_share = noise_fraction(points, noise);
     Progress first_progress = progress.slice(0.0, 0.7), normals_progress = progress.slice(0.7, 0.75),
              second_progress = progress.slice(0.75, 1.0);
-    const ThinPartBias thin =
-        dense(points) && noise_share >= kThinBiasFromNoise ? ThinPartBias::correct : ThinPartBias::off;
+    const bool sparse = !dense(points);
+    const ThinPartBias thin = !sparse && noise_share >= kThinBiasFromNoise ? ThinPartBias::correct : ThinPartBias::off;
     SmoothField first(points, measures, h, 2.0 * h, noise_share, level, params.max_memory, workers, first_progress,
                       LocalLevel::follow, thin, sparseness(kind, points));
     // Solved again from its own normals at the points (where the neighbours agree): they
@@ -158,7 +158,7 @@ std::shared_ptr<const SmoothField> solve_smooth_surface(const Params &params, Su
     // normals wrong in patches, and the first field, pulled by them, fills the space between
     // nearby parts (legs, a tail) where no point lies; the field's own normals outvote the
     // patches. A sparse cloud's solve takes a fraction of a second.
-    const bool resolve = noise_share >= kResolveFromNoise || (!dense(points) && noise_share >= kSmoothFromNoise);
+    const bool resolve = noise_share >= kResolveFromNoise || (sparse && noise_share >= kSmoothFromNoise);
     if (!resolve) {
         progress.report(1.0);
         return std::make_shared<const SmoothField>(std::move(first));

@@ -290,6 +290,25 @@ Cloud noisy_ring(RingNoise noise = RingNoise::normal, double sigma = kTubeNoise,
     return centred_cloud(xyz, outward, sigma, 4.0 * M_PI * M_PI * kRing * kTube);
 }
 
+// Walking out from a point `axis` on the ring's axis along the unit `d` in steps of `step`:
+// where f first falls to 0 or below (interpolated between the last two steps; normalised
+// units), or NaN if it does not within four tube radii. `from_inside`: f was positive the
+// step before.
+double tube_crossing(const SmoothField &field, const Cloud &c, const Vector3d &axis, const Vector3d &d, double step,
+                     bool &from_inside) {
+    double before = 0.0;
+    for (double t = 0.0; t < 4.0 * kTube * c.radius; t += step) {
+        double f;
+        if (!field.value(axis + t * d, f, nullptr)) break;
+        if (t > 0.0 && f <= 0.0) {
+            from_inside = before > 0.0;
+            return t - step * f / (f - before);
+        }
+        before = f;
+    }
+    return NAN;
+}
+
 // The noisy ring's zero set along rays out of the tube's axis, around it and along the ring:
 // the mean crossing against the tube's radius (world units).
 double ring_thickness_error(const Cloud &c, ZeroLevel level, LocalLevel local, ThinPartBias thin = ThinPartBias::off) {
@@ -306,18 +325,11 @@ double ring_thickness_error(const Cloud &c, ZeroLevel level, LocalLevel local, T
             const double u = 2.0 * M_PI * (a + 0.5) / 16.0, v = 2.0 * M_PI * b / 8.0;
             const Vector3d axis = c.centre + c.radius * kRing * Vector3d(std::cos(u), std::sin(u), 0.0);
             const Vector3d d(std::cos(v) * std::cos(u), std::cos(v) * std::sin(u), std::sin(v));
-            const double step = 0.05 * h;
-            double before = 0.0;
-            for (double t = 0.0; t < 4.0 * kTube * c.radius; t += step) {
-                double f;
-                if (!field.value(axis + t * d, f, nullptr)) break;
-                if (t > 0.0 && f <= 0.0) {
-                    sum += (t - step * f / (f - before)) / c.radius - kTube;
-                    ++rays;
-                    break;
-                }
-                before = f;
-            }
+            bool from_inside = false;
+            const double t = tube_crossing(field, c, axis, d, 0.05 * h, from_inside);
+            if (std::isnan(t)) continue;
+            sum += t / c.radius - kTube;
+            ++rays;
         }
     assert_int_equal(rays, 128);
     return sum / rays;
@@ -443,18 +455,11 @@ TubeReading read_tube(const SmoothField &field, const Cloud &c) {
         for (int b = 0; b < 8; ++b) {
             const double v = 2.0 * M_PI * b / 8.0;
             const Vector3d d(std::cos(v) * std::cos(u), std::cos(v) * std::sin(u), std::sin(v));
-            double before = 0.0;
-            for (double t = 0.0; t < 4.0 * kTube * c.radius; t += step) {
-                if (!field.value(axis + t * d, f, nullptr)) break;
-                if (t > 0.0 && f <= 0.0) {
-                    if (before > 0.0) {
-                        r.mean_error += std::fabs(t / c.radius - kTube);
-                        ++r.crossings;
-                    }
-                    break;
-                }
-                before = f;
-            }
+            bool from_inside = false;
+            const double t = tube_crossing(field, c, axis, d, step, from_inside);
+            if (std::isnan(t) || !from_inside) continue;
+            r.mean_error += std::fabs(t / c.radius - kTube);
+            ++r.crossings;
         }
     }
     if (r.crossings > 0) r.mean_error /= r.crossings;

@@ -8,7 +8,6 @@
 // within 1 % of the diagonal (recall) is 0.54; without the stronger screening 0.41, without
 // the lower floor 0.46, with the thin parts' correction 0.50.
 #include <cmath>
-#include <vector>
 
 #include "files.hpp"
 #include "mesh_checks.hpp"
