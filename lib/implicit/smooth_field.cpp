@@ -88,9 +88,6 @@ constexpr double kAcrossNoiseSteps = 0.1;
 // and its rim): near a single face's edge or bend (a CAD part's edges) the points' centre
 // moves to the side as well, and a V faded there rounds the part.
 constexpr double kOverhangFull = 0.15, kOverhangNone = 0.35, kOverhangAgreement = 0.9;
-// The outer field's grid step, in fine steps: coarse enough to cover the whole box at a
-// small cost, fine enough to keep a thin wall's two sides apart where it hands over.
-constexpr double kOuterSteps = 2.0;
 // The local zero level (follow_local_level): cells of this many grid steps, each with at
 // least kLevelCellSamples samples; a cell's correction is the samples' median value less
 // kLevelMedianErrors standard errors of that median (1.2533 σ̂ / √n for n normal draws), so
@@ -189,7 +186,7 @@ void SmoothField::for_each_node(Workers &workers, Progress &progress, const Visi
 
 SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, double spacing, double min_trust,
                          double noise, ZeroLevel level, double max_memory, Workers &workers, Progress &progress,
-                         LocalLevel local, ThinPartBias thin, Sparseness sparseness) {
+                         LocalLevel local, ThinPartBias thin, Sparseness sparseness, OuterGrid outer_grid) {
     if (points.size() == 0) return;
     max_reach_ = kMaxReachSteps * spacing;
     fine_step_ = spacing;
@@ -206,7 +203,7 @@ SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, 
         fine.lay_out(points, measures, min_trust, false, max_memory, layout_progress);
     }
     // The outer field: the same problem on a coarser grid over the whole box, solved first.
-    auto outer = std::make_shared<SmoothField>(with_step(kOuterSteps * spacing));
+    auto outer = std::make_shared<SmoothField>(with_step(outer_grid.steps * spacing));
     Progress outer_progress = progress.slice(0.0, 0.1);
     outer->solve(points, measures, measures.blend_normals, min_trust, noise, max_memory, nullptr, nullptr, true,
                  kOuterIterations, workers, outer_progress);

@@ -83,6 +83,17 @@ struct Sparseness {
     double factor = 1.0;
 };
 
+// The outer field's grid step, in the band's steps: coarse enough to cover the whole box at a
+// small cost, fine enough to keep a thin wall's two sides apart where it hands over. Where
+// the band covers the surface's neighbourhood everywhere (a dense cloud) the outer field
+// only holds the band's edge and the far sign, and a coarser grid does that as well for an
+// eighth of the unknowns; where samples lie farther apart than the band reaches (a sparse
+// cloud) the outer field carries the surface between them (pipeline/smooth_surface.cpp
+// chooses).
+struct OuterGrid {
+    double steps = 2.0;
+};
+
 class SmoothField {
 public:
     SmoothField() = default;
@@ -95,7 +106,7 @@ public:
     SmoothField(const PointSet &points, const PointMeasures &measures, double spacing, double min_trust, double noise,
                 ZeroLevel level, double max_memory, Workers &workers, Progress &progress,
                 LocalLevel local = LocalLevel::follow, ThinPartBias thin = ThinPartBias::correct,
-                Sparseness sparseness = {});
+                Sparseness sparseness = {}, OuterGrid outer_grid = {});
 
     // f and optionally ∇f at x: the band's where it is defined, else the outer field's;
     // false outside the outer field's box (f is then undefined).
@@ -108,6 +119,7 @@ public:
 
     bool empty() const { return values_.empty(); }
     size_t unknowns() const { return values_.size(); }
+    size_t outer_unknowns() const { return outer_ ? outer_->unknowns() : 0; }
     double spacing() const { return h_; }
 
 private:

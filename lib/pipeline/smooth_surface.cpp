@@ -67,6 +67,13 @@ Sparseness sparseness(SurfaceKind kind, const PointSet &points) {
     return {std::sqrt(double(kGuideBelowPoints) / double(points.size()))};
 }
 
+// A dense cloud's outer field is solved on a grid this many band steps apart (OuterGrid,
+// implicit/smooth_field.hpp), a sparse cloud's on the default: there a thin plate's outer
+// field, coarser, let the plate come apart.
+constexpr double kDenseOuterSteps = 4.0;
+
+OuterGrid outer_grid(const PointSet &points) { return dense(points) ? OuterGrid{kDenseOuterSteps} : OuterGrid{}; }
+
 double noise_fraction(const PointSet &points, double noise) {
     const double diagonal = points.world_diagonal() * points.normalisation().scale;  // normalised
     return diagonal > 0.0 ? noise / diagonal : 0.0;
@@ -149,7 +156,7 @@ std::shared_ptr<const SmoothField> solve_smooth_surface(const Params &params, Su
     const bool sparse = !dense(points);
     const ThinPartBias thin = !sparse && noise_share >= kThinBiasFromNoise ? ThinPartBias::correct : ThinPartBias::off;
     SmoothField first(points, measures, h, 2.0 * h, noise_share, level, params.max_memory, workers, first_progress,
-                      LocalLevel::follow, thin, sparseness(kind, points));
+                      LocalLevel::follow, thin, sparseness(kind, points), outer_grid(points));
     // Solved again from its own normals at the points (where the neighbours agree): they
     // are the blend's normals averaged over the field's neighbourhood, far less noisy than
     // the blend's own at noise, and scattered flips are corrected.
