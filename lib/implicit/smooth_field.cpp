@@ -44,7 +44,10 @@ constexpr double kTolerance = 1e-4;
 constexpr int kMaxIterations = 300;
 // The outer field (over the whole box) stops after fewer: it starts from the band's
 // distances, it need only be settled near the band's edge, and far from the points only
-// its sign matters; most of the solve's time would otherwise go there.
+// its sign matters; most of the solve's time would otherwise go there. This many on the
+// default outer grid (OuterGrid), proportionally fewer on a coarser one: conjugate gradients
+// carry a change about a node farther per iteration, and the same reach beyond the band's
+// edge is fewer nodes there.
 constexpr int kOuterIterations = 120;
 // A re-solve of the band starts from the first solution, which differs only where the
 // normals changed.
@@ -132,6 +135,10 @@ double sample_level(std::vector<double> &values, ZeroLevel level) {
     return median_in_place(values);
 }
 
+int outer_iterations(double outer_steps) {
+    return int(std::lround(kOuterIterations * OuterGrid{}.steps / outer_steps));
+}
+
 double weight(double d2, double r2) {
     const double t = 1.0 - d2 / r2;
     return t > 0.0 ? t * t : 0.0;
@@ -206,7 +213,7 @@ SmoothField::SmoothField(const PointSet &points, const PointMeasures &measures, 
     auto outer = std::make_shared<SmoothField>(with_step(outer_grid.steps * spacing));
     Progress outer_progress = progress.slice(0.0, 0.1);
     outer->solve(points, measures, measures.blend_normals, min_trust, noise, max_memory, nullptr, nullptr, true,
-                 kOuterIterations, workers, outer_progress);
+                 outer_iterations(outer_grid.steps), workers, outer_progress);
     // The cascade: each coarser level (twice the step) solved first, its field the next
     // level's start.
     std::vector<double> steps{spacing};
@@ -255,8 +262,8 @@ SmoothField SmoothField::resolved(const PointSet &points, const PointMeasures &m
     // the old normals' surface). Both start from the previous solution.
     auto outer = std::make_shared<SmoothField>(with_step(outer_->h_));
     Progress outer_progress = progress.slice(0.0, 0.3);
-    outer->solve(points, measures, normals, min_trust_, noise, max_memory, outer_.get(), nullptr, true, kOuterIterations,
-                 workers, outer_progress);
+    outer->solve(points, measures, normals, min_trust_, noise, max_memory, outer_.get(), nullptr, true,
+                 outer_iterations(outer_->h_ / h_), workers, outer_progress);
     Progress band_progress = progress.slice(0.3, 1.0);
     const double shift = next.solve(points, measures, normals, min_trust_, noise, max_memory, this, outer.get(), false,
                                     kResolveIterations, workers, band_progress);
