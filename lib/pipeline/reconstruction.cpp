@@ -192,10 +192,12 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
         wants_smooth
             ? solve_smooth_surface(params, kind, tree, points, measures, noise, thin_walls, pool, smooth_progress)
             : nullptr;
-    // Where the surface is the smooth field, the point normals follow it.
+    // Where the surface is the smooth field, the point normals follow it (beside thin walls
+    // only where the nearest normals agree: pipeline/smooth_normals.hpp).
     if (new_smooth && normals_follow_smooth_field(kind, points)) {
         Progress read_progress = smooth_progress.slice(1.0, 1.0);
-        measures.normals = field_point_normals(*new_smooth, points, measures, read_progress);
+        const FollowField follow = thin_walls ? FollowField::where_neighbours_agree : FollowField::every_point;
+        measures.normals = field_point_normals(*new_smooth, points, measures, read_progress, follow);
     }
     blend_grid = blend_resolution();
     smooth_grid = smooth_resolution(tree, measures);

@@ -19,7 +19,7 @@ Eigen::Vector3d normal_of(const std::vector<float> &normals, size_t i) {
 }  // namespace
 
 std::vector<float> field_point_normals(const SmoothField &field, const PointSet &points, const PointMeasures &measures,
-                                       Progress &progress) {
+                                       Progress &progress, FollowField follow) {
     std::vector<float> normals(measures.normals);
     std::vector<uint32_t> idx;
     std::vector<float> d2;
@@ -28,10 +28,12 @@ std::vector<float> field_point_normals(const SmoothField &field, const PointSet 
         double f;
         Eigen::Vector3d g;
         if (!field.value(points.point(i), f, &g) || !(g.norm() > 0.0)) continue;
-        points.nearest(points.point(i), kAgreeNeighbours, idx, d2);
-        Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-        for (uint32_t j : idx) mean += normal_of(measures.normals, j);
-        if (mean.norm() < kAgreeing * double(idx.size())) continue;
+        if (follow == FollowField::where_neighbours_agree) {
+            points.nearest(points.point(i), kAgreeNeighbours, idx, d2);
+            Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+            for (uint32_t j : idx) mean += normal_of(measures.normals, j);
+            if (mean.norm() < kAgreeing * double(idx.size())) continue;
+        }
         const Eigen::Vector3d n = -g.normalized();
         for (int d = 0; d < 3; ++d) normals[3 * i + size_t(d)] = float(n[d]);
     }
