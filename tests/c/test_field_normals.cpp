@@ -70,6 +70,22 @@ PointMeasures measures_for(const PointSet &points, const std::vector<float> &nor
     return m;
 }
 
+// The smooth field of `points` with the given normals, on a grid of step `h`, and the
+// measures it was made from (field_point_normals reads both).
+struct FieldAndMeasures {
+    PointMeasures measures;
+    SmoothField field;
+};
+
+FieldAndMeasures field_for(const PointSet &points, const std::vector<float> &normals, double h, double noise) {
+    FieldAndMeasures out;
+    out.measures = measures_for(points, normals);
+    Progress quiet(nullptr, nullptr, GMPU_STAGE_ORIENT);
+    Workers workers(2);
+    out.field = SmoothField(points, out.measures, h, 2.0 * h, noise, ZeroLevel::median, 1e9, workers, quiet);
+    return out;
+}
+
 double dot(const std::vector<float> &a, const std::vector<float> &b, size_t i) {
     return double(a[3 * i]) * b[3 * i] + double(a[3 * i + 1]) * b[3 * i + 1] + double(a[3 * i + 2]) * b[3 * i + 2];
 }
@@ -88,12 +104,9 @@ void isolated_flips_follow_the_field(void **) {
             ++flips;
             for (int k = 0; k < 3; ++k) normals[3 * i + size_t(k)] *= -1.0f;
         }
-    const PointMeasures measures = measures_for(points, normals);
+    const FieldAndMeasures fit = field_for(points, normals, 1.0 / 64, 0.005);
     Progress quiet(nullptr, nullptr, GMPU_STAGE_ORIENT);
-    Workers workers(2);
-    const double h = 1.0 / 64;
-    const SmoothField field(points, measures, h, 2.0 * h, 0.005, ZeroLevel::median, 1e9, workers, quiet);
-    const std::vector<float> out = field_point_normals(field, points, measures, quiet);
+    const std::vector<float> out = field_point_normals(fit.field, points, fit.measures, quiet);
     size_t corrected = 0, right = 0;
     for (size_t i = 0; i < points.size(); ++i) {
         const bool ok = dot(out, truth, i) > 0.0;
@@ -124,15 +137,12 @@ void wrong_patch_follows_the_field(void **) {
         if (in_patch[i] && rng() % 100 < 45)
             for (int k = 0; k < 3; ++k) normals[3 * i + size_t(k)] *= -1.0f;
     }
-    const PointMeasures measures = measures_for(points, normals);
+    const FieldAndMeasures fit = field_for(points, normals, 1.0 / 64, 0.005);
     Progress quiet(nullptr, nullptr, GMPU_STAGE_ORIENT);
-    Workers workers(2);
-    const double h = 1.0 / 64;
-    const SmoothField field(points, measures, h, 2.0 * h, 0.005, ZeroLevel::median, 1e9, workers, quiet);
     size_t right[2] = {0, 0}, right_elsewhere[2] = {0, 0};
     const FollowField follows[2] = {FollowField::where_neighbours_agree, FollowField::every_point};
     for (int f = 0; f < 2; ++f) {
-        const std::vector<float> out = field_point_normals(field, points, measures, quiet, follows[f]);
+        const std::vector<float> out = field_point_normals(fit.field, points, fit.measures, quiet, follows[f]);
         for (size_t i = 0; i < points.size(); ++i) (in_patch[i] ? right : right_elsewhere)[f] += dot(out, truth, i) > 0.0;
     }
     print_message("# patch of %zu: right %zu where the neighbours agree, %zu everywhere (elsewhere %zu, %zu of %zu)\n",
@@ -160,12 +170,9 @@ void thin_wall_keeps_its_normals(void **) {
         normals.insert(normals.end(), {0.0f, 0.0f, float(side)});
     }
     const PointSet points = PointSet::from_array(xyz.data(), n, 0, 15);
-    const PointMeasures measures = measures_for(points, normals);
+    const FieldAndMeasures fit = field_for(points, normals, 1.0 / 128, 0.002);
     Progress quiet(nullptr, nullptr, GMPU_STAGE_ORIENT);
-    Workers workers(2);
-    const double h = 1.0 / 128;
-    const SmoothField field(points, measures, h, 2.0 * h, 0.002, ZeroLevel::median, 1e9, workers, quiet);
-    const std::vector<float> out = field_point_normals(field, points, measures, quiet);
+    const std::vector<float> out = field_point_normals(fit.field, points, fit.measures, quiet);
     size_t right = 0;
     for (size_t i = 0; i < n; ++i) right += dot(out, normals, i) > 0.0;
     print_message("# thin wall: %zu of %zu normals right\n", right, n);
