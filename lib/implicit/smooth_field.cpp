@@ -390,11 +390,19 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
             const double r = radius(i), r2 = r * r;
             const double normal_r = std::min(r, normal_reach);
             const double normal_r2 = normal_r * normal_r;
-            for (int64_t z = lo[2]; z <= hi[2]; ++z)
-                for (int64_t y = lo[1]; y <= hi[1]; ++y)
+            // About half the box's nodes lie outside the ball: a row whose distance across
+            // already reaches the radius is skipped whole, and a node is tested before the
+            // weight's division.
+            for (int64_t z = lo[2]; z <= hi[2]; ++z) {
+                const double dz = origin_[2] + h_ * double(z) - p[2];
+                for (int64_t y = lo[1]; y <= hi[1]; ++y) {
+                    const double dy = origin_[1] + h_ * double(y) - p[1];
+                    if (dy * dy + dz * dz >= r2) continue;
                     for (int64_t x = lo[0]; x <= hi[0]; ++x) {
                         const Eigen::Vector3d q = origin_ + h_ * Eigen::Vector3d(double(x), double(y), double(z));
-                        const double d2 = (q - p).squaredNorm(), w = weight(d2, r2);
+                        const double d2 = (q - p).squaredNorm();
+                        if (d2 >= r2) continue;
+                        const double w = weight(d2, r2);
                         if (w <= 0.0) continue;
                         const size_t s = slot * BBB + size_t(x - base[0] + B * (y - base[1] + B * (z - base[2])));
                         wsum[s] += w;
@@ -409,6 +417,8 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
                         offset[s] += wn * (p - q);
                         distance[s] += w * (p - q).dot(nrm);  // inside (behind the normal): positive
                     }
+                }
+            }
         }
     }, 1);
     progress.throw_if_cancelled();
@@ -500,23 +510,20 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
     // field, solved over the whole box like screened Poisson's, lets the patch's error
     // relax into the space around it instead.
     if (boundary)
-        for (int64_t z = 0; z < nodes_[2]; ++z)
-            for (int64_t y = 0; y < nodes_[1]; ++y)
-                for (int64_t x = 0; x < nodes_[0]; ++x) {
-                    const int32_t a = node(x, y, z);
-                    if (a < 0) continue;
-                    for (int d = 0; d < 3; ++d)
-                        for (int dir = -1; dir <= 1; dir += 2) {
-                            const int64_t bx = x + (d == 0) * dir, by = y + (d == 1) * dir, bz = z + (d == 2) * dir;
-                            if (node(bx, by, bz) >= 0) continue;
-                            double fb;
-                            const Eigen::Vector3d qb = origin_ + h_ * Eigen::Vector3d(double(bx), double(by), double(bz));
-                            if (!boundary->value(qb, fb, nullptr)) continue;
-                            const double rise = h_ * field[size_t(a)][d] * double(dir);  // f_b − f_a wanted
-                            edge_diagonal[a] += edge_weight;
-                            rhs[a] += edge_weight * (fb - rise);
-                        }
+        for_each_node(workers, planes_progress, [&](int64_t x, int64_t y, int64_t z, int32_t a) {
+            for (int d = 0; d < 3; ++d)
+                for (int dir = -1; dir <= 1; dir += 2) {
+                    const int64_t bx = x + (d == 0) * dir, by = y + (d == 1) * dir, bz = z + (d == 2) * dir;
+                    if (node(bx, by, bz) >= 0) continue;
+                    double fb;
+                    const Eigen::Vector3d qb = origin_ + h_ * Eigen::Vector3d(double(bx), double(by), double(bz));
+                    if (!boundary->value(qb, fb, nullptr)) continue;
+                    const double rise = h_ * field[size_t(a)][d] * double(dir);  // f_b − f_a wanted
+                    edge_diagonal[a] += edge_weight;
+                    rhs[a] += edge_weight * (fb - rise);
                 }
+        });
+    progress.throw_if_cancelled();
     std::vector<Eigen::Vector3d>().swap(field);
 
     const double box_diagonal = points.world_diagonal() * points.normalisation().scale;  // normalised
@@ -532,15 +539,20 @@ double SmoothField::solve(const PointSet &points, const PointMeasures &measures,
     for (size_t i = 0; i < n; ++i) mean_area += double(measures.area[i]) / double(n);
     std::vector<int32_t> sample_node(8 * n, -1);
     std::vector<double> sample_weight(8 * n, 0.0), sample_scale(n, 0.0);
+    Progress corners_progress = progress.slice(0.3, 0.4);
+    block_for(n, workers, corners_progress, [&](size_t lo, size_t hi) {
+        for (size_t i = lo; i < hi; ++i) {
+            const Corners corner = corners((points.point(i) - origin_) / h_);
+            std::copy(corner.node, corner.node + 8, sample_node.begin() + long(8 * i));
+            std::copy(corner.weight, corner.weight + 8, sample_weight.begin() + long(8 * i));
+            // Always complete (the band covers a cell diagonal around every point); a sample
+            // that were not would simply not pull.
+            sample_scale[i] = corner.complete ? alpha * mean_area : 0.0;
+        }
+    });
+    // The diagonal sums in the samples' order, whatever the thread count.
     for (size_t i = 0; i < n; ++i) {
-        if (i % 4096 == 0) progress.poll(0.3 + 0.1 * double(i) / double(n));
-        const Corners corner = corners((points.point(i) - origin_) / h_);
-        std::copy(corner.node, corner.node + 8, sample_node.begin() + long(8 * i));
-        std::copy(corner.weight, corner.weight + 8, sample_weight.begin() + long(8 * i));
-        // Always complete (the band covers a cell diagonal around every point); a sample
-        // that were not would simply not pull.
-        sample_scale[i] = corner.complete ? alpha * mean_area : 0.0;
-        if (!corner.complete) continue;
+        if (sample_scale[i] == 0.0) continue;
         for (int k = 0; k < 8; ++k)
             diagonal[sample_node[8 * i + size_t(k)]] +=
                 sample_scale[i] * sample_weight[8 * i + size_t(k)] * sample_weight[8 * i + size_t(k)];
