@@ -100,10 +100,15 @@ def number(text):
 
 
 def reference_peers():
-    """peers.tsv → {cloud: {peer: figures}}; a failed run (empty fields) is left out."""
+    """peers.tsv → {cloud: {peer: figures}}; a failed run (empty fields) is kept as not ok,
+    with what the file says of it, so that the report can say why the figure is missing."""
     out = {}
     for r in read_tsv(PEERS_TSV):
         if number(r["f05_exact"]) is None:
+            wall = number(r["wall_s"])
+            ended = f" (the run ended after {wall:.0f} s)" if wall is not None else ""
+            out.setdefault(r["cloud"], {})[REFERENCE_PEERS[r["peer"]]] = {
+                "ok": False, "error": f"peers.tsv records no mesh{ended}"}
             continue
         out.setdefault(r["cloud"], {})[REFERENCE_PEERS[r["peer"]]] = {
             "ok": True, "orientation_accuracy": number(r["orient_pct"]) / 100,

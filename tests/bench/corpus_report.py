@@ -224,6 +224,38 @@ def cloud_table(rows):
     return head + "\n".join(lines) + "\n"
 
 
+def missing_figures(rows):
+    """Why a figure of a cloud gmpu reconstructed is shown as –: one line per missing column
+    group (Poisson on gmpu's normals, the peer, gmpu's own scores). A failed gmpu run says why
+    in its own row."""
+    def why(run):
+        text = (run or {}).get("error") or (run or {}).get("metrics_error") or "not run"
+        return " ".join(str(text).split())[:200]
+
+    out = []
+    for r in rows:
+        g = r["gmpu"]
+        if not g.get("ok"):
+            continue
+        if g.get("metrics_error"):
+            out.append(f"{r['cloud']}, gmpu's scores: {why({'error': g['metrics_error']})}")
+        q = r.get("poisson_gmpu") or {}
+        if not q.get("ok") or q.get("fscore_0.5") is None:
+            out.append(f"{r['cloud']}, Poisson(gmpu): {why(q)}")
+        if (r.get("peer") or {}).get("fscore_0.5") is None:
+            runs = r.get("peer_runs") or {}
+            reasons = "; ".join(f"{name}: {why(run)}" for name, run in sorted(runs.items()) if not run.get("ok"))
+            out.append(f"{r['cloud']}, peer: {reasons or 'no figure recorded'}")
+    return out
+
+
+def missing_note(rows):
+    lines = missing_figures(rows)
+    if not lines:
+        return ""
+    return "\nFigures shown as –, and why:\n\n" + "\n".join(f"- {l}" for l in lines) + "\n"
+
+
 def ipsr_comparison(rows, ipsr):
     """gmpu beside the committed iPSR figures, on the clouds iPSR was run on."""
     out = []
@@ -274,7 +306,7 @@ def live_peers_section(intro, targets_heading, corpus, machine, load_note=""):
         f"#### {targets_heading}\n\n" + targets(rows, []) + "\n"
         "#### Per variant\n\n" + variant_table(rows) + "\n"
         "#### Per cloud\n\n<details><summary>" + f"{len(rows)} clouds</summary>\n\n"
-        + cloud_table(rows) + "\n</details>\n")
+        + cloud_table(rows) + "\n</details>\n" + missing_note(rows))
 
 
 SPARSE_NOISY_INTRO = (
@@ -316,7 +348,7 @@ def section(corpus, machine, load_note=""):
         "#### iPSR at 1k points (committed figures, `tests/data/corpus/ipsr_reference.tsv`)\n\n"
         + ipsr_table(comparison) + "\n"
         "#### Per cloud\n\n<details><summary>" + f"{len(rows)} clouds</summary>\n\n"
-        + cloud_table(rows) + "\n</details>\n")
+        + cloud_table(rows) + "\n</details>\n" + missing_note(rows))
 
 
 def write(results, folder):

@@ -141,3 +141,23 @@ def test_the_sparse_noisy_set_samples_the_corpus_meshes():
     assert len(models) * 3 == corpus.SETS["sparse_noisy"]["count"] and set(models) <= corpus_meshes
     for variant in corpus.SPARSE_NOISY_VARIANTS:
         assert f"_{variant}.ply" in script and variant in corpus_report.VARIANT_ORDER
+
+
+def test_a_missing_figure_says_why():
+    # The committed peers failed on the clean thin plate: kept as failed runs, with the reason.
+    thin = corpus.reference_peers()["thin_plate_clean"]
+    assert not thin["cgal"]["ok"] and not thin["open3d_d8"]["ok"]
+    assert thin["open3d_d8"]["error"] == "peers.tsv records no mesh (the run ended after 180 s)"
+    assert corpus.better_peer(thin) is None
+    fine, no_poisson, no_peer = row("bear_clean"), row("cow_clean"), row("thin_plate_clean")
+    no_poisson["poisson_gmpu"] = {"ok": False, "error": "timed out after 600 s"}
+    no_peer["peer"], no_peer["peer_runs"] = None, thin
+    assert corpus_report.missing_figures([fine]) == []
+    assert corpus_report.missing_note([fine]) == ""
+    assert corpus_report.missing_figures([fine, no_poisson, no_peer]) == [
+        "cow_clean, Poisson(gmpu): timed out after 600 s",
+        "thin_plate_clean, peer: cgal: peers.tsv records no mesh (the run ended after 47 s); "
+        "open3d_d8: peers.tsv records no mesh (the run ended after 180 s)"]
+    text = corpus_report.section({"rows": [fine, no_poisson, no_peer], "peer_source": "reference", "ipsr": {}},
+                                 "a machine")
+    assert "Figures shown as –, and why:\n\n- cow_clean, Poisson(gmpu): timed out after 600 s\n" in text
