@@ -9,9 +9,9 @@ namespace {
 // gaps between samples leave it under 3 from the points, a lump past a sparse foot or tail
 // lies 10-30 out.
 constexpr double kStrayConfidence = 5.0;
-// The blend strays when at least this share of its mesh's area lies that far out: one fin
-// past a claw or a fingertip is 0.05-0.3 % of an animal's mesh, the odd triangles on the
-// sparse rims of a part that keeps to its data under 0.03 %.
+// The blend strays when at least this share of its mesh's area lies that far out: a single
+// fin past a claw or a fingertip is about this much of an animal's mesh or more, while the
+// odd triangles on the sparse rims of a part that keeps to its data stay well under it.
 constexpr double kStrayShare = 0.0005;
 }  // namespace
 
