@@ -86,6 +86,33 @@ FieldAndMeasures field_for(const PointSet &points, const std::vector<float> &nor
     return out;
 }
 
+// The noisy sphere with some normals turned over: each point of `region` (read from its true
+// normal) is turned with a chance of `numerator` in `denominator`, drawn from `seed`.
+struct SphereWithFlips {
+    std::vector<float> truth, normals;
+    PointSet points;
+    std::vector<bool> in_region, flipped;
+    size_t region_size = 0, flips = 0;
+};
+
+template <class Region>
+SphereWithFlips sphere_with_flips(uint32_t seed, const Region &region, unsigned numerator, unsigned denominator) {
+    SphereWithFlips s;
+    s.points = noisy_sphere(0.01, s.truth);
+    s.normals = s.truth;
+    s.in_region.assign(s.points.size(), false);
+    s.flipped.assign(s.points.size(), false);
+    std::mt19937 rng(seed);
+    for (size_t i = 0; i < s.points.size(); ++i) {
+        if (!(s.in_region[i] = region(&s.truth[3 * i]))) continue;
+        ++s.region_size;
+        if (!(s.flipped[i] = rng() % denominator < numerator)) continue;
+        ++s.flips;
+        for (int k = 0; k < 3; ++k) s.normals[3 * i + size_t(k)] *= -1.0f;
+    }
+    return s;
+}
+
 double dot(const std::vector<float> &a, const std::vector<float> &b, size_t i) {
     return double(a[3 * i]) * b[3 * i] + double(a[3 * i + 1]) * b[3 * i + 1] + double(a[3 * i + 2]) * b[3 * i + 2];
 }
@@ -93,18 +120,12 @@ double dot(const std::vector<float> &a, const std::vector<float> &b, size_t i) {
 // Isolated flipped normals (one point in sixteen, at random) on a noisy sphere: the field
 // points the right way at them, and the output follows it there.
 void isolated_flips_follow_the_field(void **) {
-    std::vector<float> truth;
-    const PointSet points = noisy_sphere(0.01, truth);
-    std::vector<float> normals(truth);
-    std::mt19937 rng(5);
-    std::vector<bool> flipped(points.size());
-    size_t flips = 0;
-    for (size_t i = 0; i < points.size(); ++i)
-        if ((flipped[i] = rng() % 16 == 0)) {
-            ++flips;
-            for (int k = 0; k < 3; ++k) normals[3 * i + size_t(k)] *= -1.0f;
-        }
-    const FieldAndMeasures fit = field_for(points, normals, 1.0 / 64, 0.005);
+    const SphereWithFlips s = sphere_with_flips(5, [](const float *) { return true; }, 1, 16);
+    const PointSet &points = s.points;
+    const std::vector<float> &truth = s.truth;
+    const std::vector<bool> &flipped = s.flipped;
+    const size_t flips = s.flips;
+    const FieldAndMeasures fit = field_for(points, s.normals, 1.0 / 64, 0.005);
     Progress quiet(nullptr, nullptr, GMPU_STAGE_ORIENT);
     const std::vector<float> out = field_point_normals(fit.field, points, fit.measures, quiet);
     size_t corrected = 0, right = 0;
@@ -125,19 +146,12 @@ void isolated_flips_follow_the_field(void **) {
 // follow the field everywhere are turned over; the field, shaped by the right normals around
 // and among them, points the right way.
 void wrong_patch_follows_the_field(void **) {
-    std::vector<float> truth;
-    const PointSet points = noisy_sphere(0.01, truth);
-    std::vector<float> normals(truth);
-    std::mt19937 rng(9);
-    std::vector<bool> in_patch(points.size());
-    size_t patch = 0;
-    for (size_t i = 0; i < points.size(); ++i) {
-        in_patch[i] = truth[3 * i + 2] > 0.9f;
-        patch += in_patch[i];
-        if (in_patch[i] && rng() % 100 < 45)
-            for (int k = 0; k < 3; ++k) normals[3 * i + size_t(k)] *= -1.0f;
-    }
-    const FieldAndMeasures fit = field_for(points, normals, 1.0 / 64, 0.005);
+    const SphereWithFlips s = sphere_with_flips(9, [](const float *n) { return n[2] > 0.9f; }, 45, 100);
+    const PointSet &points = s.points;
+    const std::vector<float> &truth = s.truth;
+    const std::vector<bool> &in_patch = s.in_region;
+    const size_t patch = s.region_size;
+    const FieldAndMeasures fit = field_for(points, s.normals, 1.0 / 64, 0.005);
     Progress quiet(nullptr, nullptr, GMPU_STAGE_ORIENT);
     size_t right[2] = {0, 0}, right_elsewhere[2] = {0, 0};
     const FollowField follows[2] = {FollowField::where_neighbours_agree, FollowField::every_point};
