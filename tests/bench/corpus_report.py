@@ -238,13 +238,14 @@ def missing_figures(rows):
         if not g.get("ok"):
             continue
         if g.get("metrics_error"):
-            out.append(f"{r['cloud']}, gmpu's scores: {why({'error': g['metrics_error']})}")
+            out.append(f"{r['cloud']}, gmpu's scores: {why(g)}")
         q = r.get("poisson_gmpu") or {}
         if not q.get("ok") or q.get("fscore_0.5") is None:
             out.append(f"{r['cloud']}, Poisson(gmpu): {why(q)}")
         if (r.get("peer") or {}).get("fscore_0.5") is None:
             runs = r.get("peer_runs") or {}
-            reasons = "; ".join(f"{name}: {why(run)}" for name, run in sorted(runs.items()) if not run.get("ok"))
+            reasons = "; ".join(f"{name}: {why(run)}" for name, run in sorted(runs.items())
+                                if not run.get("ok") or run.get("fscore_0.5") is None)
             out.append(f"{r['cloud']}, peer: {reasons or 'no figure recorded'}")
     return out
 

@@ -158,6 +158,11 @@ def test_a_missing_figure_says_why():
         "cow_clean, Poisson(gmpu): timed out after 600 s",
         "thin_plate_clean, peer: cgal: peers.tsv records no mesh (the run ended after 47 s); "
         "open3d_d8: peers.tsv records no mesh (the run ended after 180 s)"]
+    # A live peer that ran but could not be scored says so too, and so do gmpu's own scores.
+    unscored = row("bear_noise0.5", 0.005, metrics_error="cannot read mesh")
+    unscored["peer"], unscored["peer_runs"] = None, {"cgal": {"ok": True, "metrics_error": "bad\nmesh"}}
+    assert corpus_report.missing_figures([unscored]) == ["bear_noise0.5, gmpu's scores: cannot read mesh",
+                                                         "bear_noise0.5, peer: cgal: bad mesh"]
     text = corpus_report.section({"rows": [fine, no_poisson, no_peer], "peer_source": "reference", "ipsr": {}},
                                  "a machine")
     assert "Figures shown as –, and why:\n\n- cow_clean, Poisson(gmpu): timed out after 600 s\n" in text
