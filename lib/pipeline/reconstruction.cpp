@@ -177,7 +177,10 @@ void Reconstruction::orient(const Params &params, Progress &progress) {
     const bool wants_smooth = needs_smooth_field(kind);
     // Noise-limited fits of a thin wall may make one free sheet of it, or of a thin part of
     // a solid (free_sheet.hpp); the smooth field, not the blend, can make a slab of that.
-    if (wants_smooth && noisy_fits) {
+    // Only where the smooth field also gives the point normals: where it only guides a
+    // dense cloud's blend, the normals are the blend's, and a turned one would face a side
+    // the blend's surface does not have.
+    if (wants_smooth && noisy_fits && normals_follow_smooth_field(kind, points)) {
         const double offset = kFreeSheetOffset * noise;
         size_t turned = 0;
         if (is_free_sheet(winding, points, measures.blend_normals, offset, winding_progress)) {
