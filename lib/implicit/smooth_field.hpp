@@ -37,6 +37,10 @@
 // long-range part). `resolved` solves the problem again from other normals (the field's own
 // at the points, pipeline/smooth_surface.cpp), outer field and band both, each started from
 // the previous solution.
+//
+// smooth_field.cpp holds the grid, the cascade and the solve; smooth_field_band.cpp the
+// splats and the edges' equations; smooth_field_samples.cpp the screening term;
+// smooth_field_levels.cpp the zero levels' corrections and the thin parts' bias.
 #pragma once
 
 #include <cstdint>
@@ -133,6 +137,47 @@ private:
     double solve(const PointSet &points, const PointMeasures &measures, const std::vector<float> &normals,
                  double min_trust, double noise, double max_memory, const SmoothField *coarse,
                  const SmoothField *boundary, bool whole_box, int iterations, Workers &workers, Progress &progress);
+    // What the points' splats leave at a node of the laid-out blocks: their weights' sum and
+    // weighted point-to-plane distances, and, over V's shorter reach, the normals' weights,
+    // weighted normals and weighted offsets from the node to the points.
+    struct NodeSums {
+        double wsum = 0.0, distance = 0.0, normal_wsum = 0.0;
+        Eigen::Vector3d normal = Eigen::Vector3d::Zero(), offset = Eigen::Vector3d::Zero();
+    };
+    // The band's equations but the samples': per unknown its six neighbours (−x, +x, −y, +y,
+    // −z, +z; −1 where the band ends), the edges' part of the diagonal, every edge's weight,
+    // the right-hand side and the start.
+    struct BandEquations {
+        std::vector<int32_t> neighbours;
+        Eigen::VectorXd edge_diagonal, rhs, start;
+        double edge_weight = 0.0;
+    };
+    // The samples' screening term: per sample its cube's 8 corner unknowns, their trilinear
+    // weights and its pull α·A (0: it does not pull); per unknown the (sample, corner) pairs
+    // that land on it, in sample order: row_pairs[row_start[u] .. row_start[u + 1]).
+    struct SampleRows {
+        std::vector<int32_t> node;
+        std::vector<double> weight, scale;
+        std::vector<uint32_t> row_start, row_pairs;
+        // f (the solution `x`) at sample i: its cube's corners blended trilinearly.
+        double value(size_t i, const Eigen::VectorXd &x) const;
+    };
+    // The splats of the points (with `normals`) on the `slots` laid-out blocks
+    // (smooth_field_band.cpp); `sigma`: the noise's deviation in normalised units.
+    std::vector<NodeSums> splat(const PointSet &points, const PointMeasures &measures, const std::vector<float> &normals,
+                                double min_trust, double sigma, int32_t slots, Workers &workers,
+                                Progress &progress) const;
+    // Numbers the band's unknowns (the nodes some splat reached, every node when
+    // `whole_box`), and from the splats V and the start (`coarse`'s values where it has
+    // them) and the edges' equations, with `boundary`'s values at the band's edge.
+    BandEquations band_equations(std::vector<NodeSums> &&sums, const SmoothField *coarse,
+                                 const SmoothField *boundary, bool whole_box, Workers &workers, Progress &progress);
+    // The samples' rows for the screening weight that `noise` sets (smooth_field_samples.cpp);
+    // adds their part of the matrix's diagonal to `diagonal`.
+    SampleRows sample_rows(const PointSet &points, const PointMeasures &measures, double noise, int32_t unknowns,
+                           Eigen::VectorXd &diagonal, Workers &workers, Progress &progress) const;
+    // The index of node (x, y, z) of a laid-out block among the blocks' nodes.
+    size_t slot_node(int64_t x, int64_t y, int64_t z) const;
     // The local zero level: where the samples of a cell of a few grid steps lie on one side
     // of f's zero set by more than the noise explains (their median past one standard error
     // of it), f there is shifted by the rest, at most a grid step, blended trilinearly
@@ -140,9 +185,8 @@ private:
     // grid's scale (a gear's teeth and their roots, a tail's tip) the same way at every
     // noise; one global level cannot undo that, a stronger pull through every sample follows
     // the noise everywhere. `sigma`: the noise's deviation on this grid (normalised units).
-    void follow_local_level(const PointSet &points, const std::vector<int32_t> &sample_node,
-                            const std::vector<double> &sample_weight, const std::vector<double> &sample_scale,
-                            double sigma, Eigen::VectorXd &x, Workers &workers, Progress &progress);
+    void follow_local_level(const PointSet &points, const SampleRows &samples, double sigma, Eigen::VectorXd &x,
+                            Workers &workers, Progress &progress);
     // The noise's bias on thin parts, to be added to f (the solution `x`) once its levels
     // are set. Noise in every direction moves a sample off a curved surface outward on
     // average: f's expected value at the samples is f + σ²/2 Δf on the surface, so a zero
@@ -177,7 +221,16 @@ private:
     // visit(x, y, z, u) for every node u of the band, the grid's planes in parallel (each
     // node visited once, so a visit may write its own node's entries).
     template <class Visit>
-    void for_each_node(Workers &workers, Progress &progress, const Visit &visit) const;
+    void for_each_node(Workers &workers, Progress &progress, const Visit &visit) const {
+        parallel_for(0, size_t(nodes_[2]), workers, progress, [&](size_t plane) {
+            const int64_t z = int64_t(plane);
+            for (int64_t y = 0; y < nodes_[1]; ++y)
+                for (int64_t x = 0; x < nodes_[0]; ++x) {
+                    const int32_t u = node(x, y, z);
+                    if (u >= 0) visit(x, y, z, u);
+                }
+        }, 1);
+    }
     Eigen::Vector3d node_gradient(int64_t x, int64_t y, int64_t z) const;
 
     Eigen::Vector3d origin_ = Eigen::Vector3d::Zero();

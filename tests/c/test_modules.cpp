@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "core/cancellable_sort.hpp"
+#include "core/conjugate_gradients.hpp"
 #include "core/resize_reporting.hpp"
 #include "core/error.hpp"
 #include "core/parallel.hpp"
@@ -826,6 +827,45 @@ void pieces_smaller_than_a_side_are_dropped(void **) {
     assert_near(tiny.vertices[0], 5.0, 0);
 }
 
+// ---- conjugate gradients ------------------------------------------------------------------
+
+// A 1-D Laplacian with a screening term, tridiagonal and symmetric positive definite, larger
+// than one block of the sums: the solution satisfies the system, the same bits come out on
+// 1 and 3 threads, and the iteration cap and the cancel are kept.
+void conjugate_gradients_solve_and_keep_their_bits(void **) {
+    const Eigen::Index n = 20000;
+    auto apply = [&](const Eigen::VectorXd &v, Eigen::VectorXd &out) {
+        for (Eigen::Index i = 0; i < n; ++i)
+            out[i] = 2.1 * v[i] - (i > 0 ? v[i - 1] : 0.0) - (i + 1 < n ? v[i + 1] : 0.0);
+    };
+    Eigen::VectorXd rhs(n), diagonal = Eigen::VectorXd::Constant(n, 2.1);
+    for (Eigen::Index i = 0; i < n; ++i) rhs[i] = std::sin(0.01 * double(i)) + (i % 7 == 0 ? 1.0 : 0.0);
+    auto solve = [&](unsigned threads, int iterations, Progress &progress, int &taken) {
+        Workers workers(threads);
+        Eigen::VectorXd x = Eigen::VectorXd::Zero(n);
+        taken = conjugate_gradients(apply, rhs, diagonal, x, 1e-10, iterations, workers, progress, 0.5);
+        return x;
+    };
+    Progress progress(nullptr, nullptr, GMPU_STAGE_ORIENT);
+    int taken_one = 0, taken_three = 0, capped = 0;
+    const Eigen::VectorXd one = solve(1, 1000, progress, taken_one), three = solve(3, 1000, progress, taken_three);
+    Eigen::VectorXd residual(n);
+    apply(one, residual);
+    residual -= rhs;
+    print_message("conjugate gradients: %d iterations, residual %.3g of the right-hand side\n", taken_one,
+                  residual.norm() / rhs.norm());
+    assert_true(residual.norm() <= 1e-9 * rhs.norm());
+    assert_true(taken_one > 5 && taken_one < 1000);
+    assert_int_equal(taken_one, taken_three);
+    assert_memory_equal(one.data(), three.data(), size_t(n) * sizeof(double));
+    solve(2, 3, progress, capped);
+    assert_int_equal(capped, 3);
+    Progress cancelled(nullptr, nullptr, GMPU_STAGE_ORIENT);
+    cancelled.cancel();
+    int never = 0;
+    assert_int_equal(status_of([&] { solve(2, 1000, cancelled, never); }), GMPU_ERROR_CANCELLED);
+}
+
 // ---- parallel loop ------------------------------------------------------------------------
 
 void parallel_for_runs_each_index_once(void **) {
@@ -1024,6 +1064,7 @@ int main(void) {
         cmocka_unit_test(marching_cubes_sphere_needs_few_triangles),
         cmocka_unit_test(unsupported_components_are_dropped),
         cmocka_unit_test(pieces_smaller_than_a_side_are_dropped),
+        cmocka_unit_test(conjugate_gradients_solve_and_keep_their_bits),
         cmocka_unit_test(parallel_for_runs_each_index_once),
         cmocka_unit_test(parallel_for_rethrows_and_cancels),
         cmocka_unit_test(only_the_final_report_says_done),
