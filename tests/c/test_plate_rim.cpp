@@ -1,4 +1,4 @@
-// A thin part's edge at noise (implicit/smooth_field.cpp, the normals' overhang): a plate
+// A thin part's edge at noise (implicit/smooth_field_band.cpp, the normals' overhang): a plate
 // whose two faces lie a few noise deviations apart keeps both faces, and the smooth field
 // makes its surface. Past the rim the faces' normals used to reach the nodes from one side
 // at full length and ask f to rise towards the plate's middle plane there: the plate grew
