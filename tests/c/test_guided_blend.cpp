@@ -126,12 +126,25 @@ void dense_cloud_with_one_small_stray_is_guided(void **) {
     assert_true(same_mesh(r.other.mesh, guided.mesh));
 }
 
+// A shared cloud reconstructed as the blend (surface 0) and with the automatic surface.
+struct BlendAndAutomatic {
+    std::vector<Vec3> points;
+    Reconstruction blend, automatic;
+};
+
+BlendAndAutomatic blend_and_automatic(const char *cloud) {
+    BlendAndAutomatic r;
+    r.points = load_points(test_data(cloud)).positions;
+    r.blend = reconstruct(r.points, {{GMPU_PARAM_SURFACE, 0}});
+    r.automatic = reconstruct(r.points);
+    assert_int_equal(r.blend.status, GMPU_OK);
+    assert_int_equal(r.automatic.status, GMPU_OK);
+    return r;
+}
+
 void dense_cloud_whose_blend_keeps_to_the_data_keeps_the_blend(void **) {
-    const std::vector<Vec3> points = load_points(test_data("clouds/bunny_clean.ply")).positions;
-    Reconstruction blend = reconstruct(points, {{GMPU_PARAM_SURFACE, 0}});
-    Reconstruction automatic = reconstruct(points);
-    assert_int_equal(blend.status, GMPU_OK);
-    assert_int_equal(automatic.status, GMPU_OK);
+    const BlendAndAutomatic r = blend_and_automatic("clouds/bunny_clean.ply");
+    const Reconstruction &blend = r.blend, &automatic = r.automatic;
     assert_true(same_mesh(automatic.mesh, blend.mesh));
     // The mesh orient made for its test is handed out once; asked again, polygonize makes
     // the same mesh anew, and at another grid another one.
@@ -154,14 +167,10 @@ void dense_cloud_whose_blend_keeps_to_the_data_keeps_the_blend(void **) {
 // normals near an edge (against the true side) where the guiding field was asked for;
 // nothing but the guide uses the smooth field here, so nothing should turn them.
 void dense_guided_blend_keeps_the_blends_normals(void **) {
-    const std::vector<Vec3> points = load_points(test_data("clouds/fandisk_noise0.25.ply")).positions;
-    Reconstruction blend = reconstruct(points, {{GMPU_PARAM_SURFACE, 0}});
-    Reconstruction automatic = reconstruct(points);
-    assert_int_equal(blend.status, GMPU_OK);
-    assert_int_equal(automatic.status, GMPU_OK);
-    assert_false(same_mesh(automatic.mesh, blend.mesh));  // guided
-    assert_int_equal(automatic.normals.size(), points.size());
-    assert_true(automatic.normals == blend.normals);
+    const BlendAndAutomatic r = blend_and_automatic("clouds/fandisk_noise0.25.ply");
+    assert_false(same_mesh(r.automatic.mesh, r.blend.mesh));  // guided
+    assert_int_equal(r.automatic.normals.size(), r.points.size());
+    assert_true(r.automatic.normals == r.blend.normals);
 }
 
 // 5,000 noise-free points of a capped pipe whose wall (0.02) is about a sample spacing
