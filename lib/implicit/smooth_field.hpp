@@ -49,6 +49,7 @@
 
 #include <Eigen/Core>
 
+#include "core/huge_page_allocator.hpp"
 #include "core/parallel.hpp"
 #include "core/progress.hpp"
 #include "geometry/point_set.hpp"
@@ -148,7 +149,7 @@ private:
     // −z, +z; −1 where the band ends), the edges' part of the diagonal, every edge's weight,
     // the right-hand side and the start.
     struct BandEquations {
-        std::vector<int32_t> neighbours;
+        HugePageVector<int32_t> neighbours;
         Eigen::VectorXd edge_diagonal, rhs, start;
         double edge_weight = 0.0;
     };
@@ -156,21 +157,23 @@ private:
     // weights and its pull α·A (0: it does not pull); per unknown the (sample, corner) pairs
     // that land on it, in sample order: row_pairs[row_start[u] .. row_start[u + 1]).
     struct SampleRows {
-        std::vector<int32_t> node;
-        std::vector<double> weight, scale;
-        std::vector<uint32_t> row_start, row_pairs;
+        HugePageVector<int32_t> node;
+        HugePageVector<double> weight;
+        std::vector<double> scale;
+        std::vector<uint32_t> row_start;
+        HugePageVector<uint32_t> row_pairs;
         // f (the solution `x`) at sample i: its cube's corners blended trilinearly.
         double value(size_t i, const Eigen::VectorXd &x) const;
     };
     // The splats of the points (with `normals`) on the `slots` laid-out blocks
     // (smooth_field_band.cpp); `sigma`: the noise's deviation in normalised units.
-    std::vector<NodeSums> splat(const PointSet &points, const PointMeasures &measures, const std::vector<float> &normals,
+    HugePageVector<NodeSums> splat(const PointSet &points, const PointMeasures &measures, const std::vector<float> &normals,
                                 double min_trust, double sigma, int32_t slots, Workers &workers,
                                 Progress &progress) const;
     // Numbers the band's unknowns (the nodes some splat reached, every node when
     // `whole_box`), and from the splats V and the start (`coarse`'s values where it has
     // them) and the edges' equations, with `boundary`'s values at the band's edge.
-    BandEquations band_equations(std::vector<NodeSums> &&sums, const SmoothField *coarse,
+    BandEquations band_equations(HugePageVector<NodeSums> &&sums, const SmoothField *coarse,
                                  const SmoothField *boundary, bool whole_box, Workers &workers, Progress &progress);
     // The samples' rows for the screening weight that `noise` sets (smooth_field_samples.cpp);
     // adds their part of the matrix's diagonal to `diagonal`.
@@ -245,7 +248,7 @@ private:
     int64_t nodes_[3] = {0, 0, 0};     // per axis
     int64_t blocks_[3] = {0, 0, 0};    // per axis
     std::vector<int32_t> block_slot_;  // per block: its slot in node_index_ (÷ B³), or -1
-    std::vector<int32_t> node_index_;  // per slot node: unknown index or -1
+    HugePageVector<int32_t> node_index_;  // per slot node: unknown index or -1
     std::vector<double> values_;       // per unknown
     std::shared_ptr<const SmoothField> outer_;  // the coarse field over the whole box, or null
 };

@@ -79,7 +79,7 @@ size_t SmoothField::slot_node(int64_t x, int64_t y, int64_t z) const {
            size_t(x % B + B * (y % B + B * (z % B)));
 }
 
-std::vector<SmoothField::NodeSums> SmoothField::splat(const PointSet &points, const PointMeasures &measures,
+HugePageVector<SmoothField::NodeSums> SmoothField::splat(const PointSet &points, const PointMeasures &measures,
                                                       const std::vector<float> &normals, double min_trust,
                                                       double sigma, int32_t slots, Workers &workers,
                                                       Progress &progress) const {
@@ -87,7 +87,7 @@ std::vector<SmoothField::NodeSums> SmoothField::splat(const PointSet &points, co
     auto radius = [&](size_t i) { return splat_radius(measures, i, min_trust); };
     auto node_box = [&](size_t i, int64_t lo[3], int64_t hi[3]) { box_of(points.point(i), radius(i), lo, hi); };
     constexpr size_t BBB = size_t(B) * B * B;
-    std::vector<NodeSums> sums(size_t(slots) * BBB);
+    HugePageVector<NodeSums> sums(size_t(slots) * BBB);
     // Each block of nodes sums the points whose boxes reach it, in the points' order (so a
     // node's sums do not depend on the thread count); the blocks run in parallel.
     std::vector<uint32_t> block_start(size_t(slots) + 1, 0), block_points;
@@ -169,7 +169,7 @@ std::vector<SmoothField::NodeSums> SmoothField::splat(const PointSet &points, co
     return sums;
 }
 
-SmoothField::BandEquations SmoothField::band_equations(std::vector<NodeSums> &&sums, const SmoothField *coarse,
+SmoothField::BandEquations SmoothField::band_equations(HugePageVector<NodeSums> &&sums, const SmoothField *coarse,
                                                        const SmoothField *boundary, bool whole_box, Workers &workers,
                                                        Progress &progress) {
     node_index_.assign(sums.size(), -1);
@@ -180,7 +180,7 @@ SmoothField::BandEquations SmoothField::band_equations(std::vector<NodeSums> &&s
     BandEquations eq;
     eq.rhs = Eigen::VectorXd::Zero(unknowns);
     eq.start.resize(unknowns);
-    std::vector<Eigen::Vector3d> field(static_cast<size_t>(unknowns));
+    HugePageVector<Eigen::Vector3d> field(static_cast<size_t>(unknowns));
     Progress planes_progress = progress.slice(0.2, 0.2);  // the loops over planes only check for a cancel
     for_each_node(workers, planes_progress, [&](int64_t x, int64_t y, int64_t z, int32_t u) {
         const NodeSums &at = sums[slot_node(x, y, z)];
@@ -226,7 +226,7 @@ SmoothField::BandEquations SmoothField::band_equations(std::vector<NodeSums> &&s
                 }
         }
     }
-    std::vector<NodeSums>().swap(sums);  // before the edges' arrays
+    HugePageVector<NodeSums>().swap(sums);  // before the edges' arrays
     eq.edge_weight = h_;  // Σ over edges of h·(Δf − h·V)² approximates ∫|∇f − V|²
     const double edge_weight = eq.edge_weight;
     eq.edge_diagonal = Eigen::VectorXd::Zero(unknowns);

@@ -1,13 +1,15 @@
 // Large arrays ask for transparent huge pages (core/huge_pages.hpp): the advice must reach
 // the kernel for the arrays the pipeline fills point by point. Checked on the mapping's
 // flags (VmFlags "hg" in /proc/self/smaps), which the advice sets whether or not huge pages
-// are free at the moment, so the test does not depend on the machine's memory state.
+// are free at the moment, so the test does not depend on the machine's memory state. The
+// working arrays' allocator (core/huge_page_allocator.hpp) is checked the same way.
 #include <cstdint>
 #include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "core/huge_page_allocator.hpp"
 #include "core/huge_pages.hpp"
 #include "core/progress.hpp"
 #include "core/resize_reporting.hpp"
@@ -72,12 +74,38 @@ void small_arrays_are_left_alone(void **) {
     assert_false(advised(small.data()));
 }
 
+// A working array of 2 MB or more starts on a 2 MB boundary and lies on advised pages to its
+// end; one grown past that size by push_back moves there with its contents.
+void working_arrays_lie_on_whole_huge_pages(void **) {
+    HugePageVector<double> big(size_t(3) << 18);  // 6 MB, value-initialised
+    assert_int_equal(reinterpret_cast<uintptr_t>(big.data()) % kHugePageBytes, 0);
+    for (double v : big) assert_true(v == 0.0);
+    if (thp_available()) {
+        assert_true(advised(big.data()));
+        assert_true(advised(&big.back()));
+    }
+    HugePageVector<uint32_t> grown;
+    for (uint32_t i = 0; i < (uint32_t(1) << 20); ++i) grown.push_back(i);  // 4 MB at the end
+    assert_int_equal(reinterpret_cast<uintptr_t>(grown.data()) % kHugePageBytes, 0);
+    for (uint32_t i = 0; i < grown.size(); ++i) assert_int_equal(grown[i], i);
+    if (thp_available()) assert_true(advised(grown.data()));
+}
+
+void small_working_arrays_are_left_alone(void **) {
+    HugePageVector<char> small(1 << 20);
+    if (thp_available()) assert_false(advised(small.data()));
+    small.assign(small.size(), 'x');
+    assert_int_equal(small.back(), 'x');
+}
+
 }  // namespace
 
 int main() {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(reported_arrays_are_advised),
         cmocka_unit_test(small_arrays_are_left_alone),
+        cmocka_unit_test(working_arrays_lie_on_whole_huge_pages),
+        cmocka_unit_test(small_working_arrays_are_left_alone),
     };
     return cmocka_run_group_tests(tests, nullptr, nullptr);
 }
