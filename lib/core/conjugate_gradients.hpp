@@ -10,6 +10,7 @@
 #include <Eigen/Core>
 
 #include "core/block_sums.hpp"
+#include "core/huge_pages.hpp"
 #include "core/progress.hpp"
 
 namespace gmpu {
@@ -27,6 +28,7 @@ int conjugate_gradients(const Apply &apply, const Eigen::VectorXd &rhs, const Ei
     const size_t rows = size_t(unknowns);
     const Eigen::VectorXd inverse_diagonal = diagonal.cwiseInverse();
     Eigen::VectorXd r(unknowns), Ap(unknowns), z(unknowns), p(unknowns);
+    for (const Eigen::VectorXd *v : {&r, &Ap, &z, &p}) advise_huge_pages(*v);
     apply(x, Ap);
     std::array<double, 2> rz_rr = block_sums<2>(rows, workers, quiet, [&](size_t lo, size_t hi) {
         std::array<double, 2> sum{};

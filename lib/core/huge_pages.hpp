@@ -20,4 +20,11 @@ void advise_huge_pages(const std::vector<T, A> &v) {
     advise_huge_pages(v.data(), v.capacity() * sizeof(T));
 }
 
+// The same for a dense Eigen vector or matrix (anything with data() and size()): call it
+// after sizing it uninitialised, before filling.
+template <class Dense>
+auto advise_huge_pages(const Dense &m) -> decltype(m.data(), m.size(), void()) {
+    advise_huge_pages(m.data(), size_t(m.size()) * sizeof(*m.data()));
+}
+
 }  // namespace gmpu

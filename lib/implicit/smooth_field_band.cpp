@@ -8,6 +8,7 @@
 
 #include <vector>
 
+#include "core/huge_pages.hpp"
 #include "implicit/point_measures.hpp"
 
 namespace gmpu {
@@ -178,8 +179,11 @@ SmoothField::BandEquations SmoothField::band_equations(HugePageVector<NodeSums> 
         if (sums[s].wsum > 0.0 || whole_box) node_index_[s] = unknowns++;
     const double normal_reach = normal_reach_of(h_);
     BandEquations eq;
-    eq.rhs = Eigen::VectorXd::Zero(unknowns);
-    eq.start.resize(unknowns);
+    for (Eigen::VectorXd *v : {&eq.rhs, &eq.start, &eq.edge_diagonal}) {
+        v->resize(unknowns);
+        advise_huge_pages(*v);
+    }
+    eq.rhs.setZero();
     HugePageVector<Eigen::Vector3d> field(static_cast<size_t>(unknowns));
     Progress planes_progress = progress.slice(0.2, 0.2);  // the loops over planes only check for a cancel
     for_each_node(workers, planes_progress, [&](int64_t x, int64_t y, int64_t z, int32_t u) {
@@ -229,7 +233,7 @@ SmoothField::BandEquations SmoothField::band_equations(HugePageVector<NodeSums> 
     HugePageVector<NodeSums>().swap(sums);  // before the edges' arrays
     eq.edge_weight = h_;  // Σ over edges of h·(Δf − h·V)² approximates ∫|∇f − V|²
     const double edge_weight = eq.edge_weight;
-    eq.edge_diagonal = Eigen::VectorXd::Zero(unknowns);
+    eq.edge_diagonal.setZero();
     // The edges' part of the matrix: every edge weighs the same, so it is the unknowns'
     // neighbours (−x, +x, −y, +y, −z, +z; −1 where the band ends) and that weight.
     eq.neighbours.assign(6 * size_t(unknowns), -1);

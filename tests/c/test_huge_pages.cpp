@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "core/huge_page_allocator.hpp"
 #include "core/huge_pages.hpp"
 #include "core/progress.hpp"
@@ -67,6 +69,14 @@ void reported_arrays_are_advised(void **) {
     assert_true(advised(inside_aligned_part(big.data())));
 }
 
+// Eigen vectors sized uninitialised, as the solvers' work vectors are.
+void eigen_vectors_are_advised(void **) {
+    if (!thp_available()) skip();
+    Eigen::VectorXd v(Eigen::Index(1) << 20);  // 8 MB
+    advise_huge_pages(v);
+    assert_true(advised(inside_aligned_part(v.data())));
+}
+
 void small_arrays_are_left_alone(void **) {
     if (!thp_available()) skip();
     std::vector<char> small(1 << 20);
@@ -103,6 +113,7 @@ void small_working_arrays_are_left_alone(void **) {
 int main() {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(reported_arrays_are_advised),
+        cmocka_unit_test(eigen_vectors_are_advised),
         cmocka_unit_test(small_arrays_are_left_alone),
         cmocka_unit_test(working_arrays_lie_on_whole_huge_pages),
         cmocka_unit_test(small_working_arrays_are_left_alone),
